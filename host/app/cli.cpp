@@ -1,0 +1,108 @@
+#include "app/cli.hpp"
+
+#include <charconv>
+#include <cstring>
+#include <string_view>
+
+namespace kiln::app {
+
+const char* kUsage = R"(kiln — a render-pass framework with hot reload
+
+usage: kiln [options]
+
+  --pipeline FILE   pipeline graph (default pipelines/default.json)
+  --scene FILE      scene description (default scenes/cornell.json)
+  --headless        render with EGL, no window
+  --size WxH        output size (default 720x720)
+  --frames N        frames to render in headless mode (default 1)
+  --out FILE.png    write the final image (headless)
+  --dump DIR        write every texture of the last frame (PNG, and PFM for float/depth)
+  --stats           print the per-pass time table (GPU timer queries + CPU clock)
+  --no-skip         run every pass every frame, even when nothing it reads changed
+  --plan            print the compiled plan (order, culled passes and why)
+  --dot FILE        write the plan as graphviz dot
+  --view PASS.OUT   show this texture instead of the graph output (un-culls its producer)
+  --seed N          simulation seed (same seed, same frames)
+  --paused          do not advance the simulation
+  --shaders DIR     shader root (default shaders/)
+  --modules DIR     pass module directory (default: the build's modules/)
+  --help            this text
+
+Window keys:
+  mouse drag (empty space)  orbit the camera      wheel  zoom
+  F1  toggle the debug view     Esc  quit
+)";
+
+namespace {
+bool parseInt(std::string_view s, long long& out) {
+    auto r = std::from_chars(s.data(), s.data() + s.size(), out);
+    return r.ec == std::errc() && r.ptr == s.data() + s.size();
+}
+}  // namespace
+
+std::optional<Options> parseOptions(int argc, char** argv, std::string& error) {
+    Options o;
+    for (int i = 1; i < argc; ++i) {
+        std::string_view a = argv[i];
+        auto value = [&](std::string_view name) -> std::optional<std::string> {
+            if (i + 1 >= argc) {
+                error = std::string(name) + " needs a value";
+                return std::nullopt;
+            }
+            return std::string(argv[++i]);
+        };
+        if (a == "--help" || a == "-h") {
+            o.help = true;
+        } else if (a == "--headless") {
+            o.headless = true;
+        } else if (a == "--stats") {
+            o.stats = true;
+        } else if (a == "--no-skip") {
+            o.noSkip = true;
+        } else if (a == "--plan") {
+            o.printPlan = true;
+        } else if (a == "--paused") {
+            o.paused = true;
+        } else if (a == "--pipeline" || a == "--scene" || a == "--out" || a == "--dump" || a == "--dot" ||
+                   a == "--shaders" || a == "--modules" || a == "--view") {
+            auto v = value(a);
+            if (!v) return std::nullopt;
+            std::string* dst = a == "--pipeline" ? &o.pipeline
+                             : a == "--scene"    ? &o.scene
+                             : a == "--out"      ? &o.out
+                             : a == "--dump"     ? &o.dump
+                             : a == "--dot"      ? &o.dot
+                             : a == "--shaders"  ? &o.shaderRoot
+                             : a == "--modules"  ? &o.moduleDir
+                                                 : &o.view;
+            *dst = *v;
+        } else if (a == "--size") {
+            auto v = value(a);
+            if (!v) return std::nullopt;
+            auto x = v->find('x');
+            long long w = 0, h = 0;
+            if (x == std::string::npos || !parseInt(std::string_view(*v).substr(0, x), w) ||
+                !parseInt(std::string_view(*v).substr(x + 1), h) || w < 1 || h < 1 || w > 16384 || h > 16384) {
+                error = "--size " + *v + ": expected WxH with 1 <= W, H <= 16384 (e.g. 720x720)";
+                return std::nullopt;
+            }
+            o.width = static_cast<int>(w);
+            o.height = static_cast<int>(h);
+        } else if (a == "--frames" || a == "--seed") {
+            auto v = value(a);
+            if (!v) return std::nullopt;
+            long long n = 0;
+            if (!parseInt(*v, n) || n < (a == "--frames" ? 1 : 0)) {
+                error = std::string(a) + " " + *v + ": expected a " + (a == "--frames" ? "positive" : "non-negative") + " integer";
+                return std::nullopt;
+            }
+            if (a == "--frames") o.frames = static_cast<int>(n); else o.seed = static_cast<uint64_t>(n);
+        } else {
+            error = "unknown argument \"" + std::string(a) + "\" (see kiln --help)";
+            return std::nullopt;
+        }
+    }
+    return o;
+}
+
+}  // namespace kiln::app

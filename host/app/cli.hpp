@@ -1,0 +1,35 @@
+// app/cli.hpp — the `kiln` command line (SPEC §10).
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+namespace kiln::app {
+
+struct Options {
+    std::string pipeline;     // default: <source>/pipelines/default.json
+    std::string scene;        // default: <source>/scenes/cornell.json
+    std::string shaderRoot;   // default: <source>/shaders
+    std::string moduleDir;    // default: the build's modules directory
+    bool headless = false;
+    int width = 720, height = 720;
+    int frames = 1;
+    std::string out;          // PNG of the final image
+    std::string dump;         // directory for every texture of the last frame
+    bool stats = false;
+    bool noSkip = false;      // run every pass every frame (for timing tables)
+    bool printPlan = false;
+    std::string dot;          // write the plan as graphviz
+    uint64_t seed = 1;
+    bool paused = false;      // freeze the simulation (time stays at 0 + frames×0)
+    bool help = false;
+    std::string view;         // "pass.output" to show instead of the graph output
+};
+
+extern const char* kUsage;
+
+// Parses argv; on a bad argument returns nullopt and sets `error` to one line.
+std::optional<Options> parseOptions(int argc, char** argv, std::string& error);
+
+}  // namespace kiln::app

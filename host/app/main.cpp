@@ -1,0 +1,79 @@
+// kiln — the host program: reads a pipeline graph, loads its pass modules, and runs
+// it in a window (GLFW + Dear ImGui) or headless (EGL) into PNG files.
+#include <GLFW/glfw3.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include "app/app.hpp"
+#include "app/cli.hpp"
+#include "app/context.hpp"
+#include "kiln/image_io.hpp"
+#include "kiln/log.hpp"
+
+namespace fs = std::filesystem;
+using namespace kiln;
+using namespace kiln::app;
+
+namespace {
+
+int fail(const std::string& message) {
+    std::fprintf(stderr, "kiln: error: %s\n", message.c_str());
+    return 1;
+}
+
+void fillDefaults(Options& o) {
+    const fs::path source = KILN_SOURCE_DIR;
+    if (o.pipeline.empty()) o.pipeline = (source / "pipelines/default.json").string();
+    if (o.scene.empty()) o.scene = (source / "scenes/cornell.json").string();
+    if (o.shaderRoot.empty()) o.shaderRoot = (source / "shaders").string();
+    if (o.moduleDir.empty()) o.moduleDir = KILN_MODULE_DIR;
+}
+
+int runHeadless(const Options& o) {
+    std::string error;
+    auto context = HeadlessContext::create(/*debug=*/true, error);
+    if (!context) return fail(error);
+    log::info("headless: ", context->description());
+    App app;
+    if (!app.init(o, error)) return fail(error);
+
+    app.runtime().alwaysRun = o.noSkip;
+    for (int f = 0; f < o.frames; ++f) app.frame();
+    glFinish();
+    app.runtime().collectGpuTimes();
+
+    if (!o.out.empty()) {
+        const TextureRef* out = app.displayedTexture();
+        if (!out) return fail("the pipeline produced no output texture");
+        FloatImage img = readTexture(out->id, out->target, out->format, out->width, out->height);
+        if (!writePng(o.out, img, 3, error)) return fail(error);
+        log::info("wrote ", o.out, " (", img.width, "x", img.height, ")");
+    }
+    if (!o.dump.empty()) {
+        if (!app.runtime().dump(o.dump, error)) return fail(error);
+        log::info("dumped ", app.runtime().textures().size(), " textures to ", o.dump);
+    }
+    if (o.stats) std::printf("%s", app.runtime().statsTable().c_str());
+    auto errors = app.runtime().activeErrors();
+    if (!errors.empty()) return fail(errors.front());
+    return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    std::string error;
+    auto parsed = parseOptions(argc, argv, error);
+    if (!parsed) return fail(error);
+    Options o = *parsed;
+    if (o.help) {
+        std::printf("%s", kUsage);
+        return 0;
+    }
+    fillDefaults(o);
+    if (o.headless) return runHeadless(o);
+    return runWindow(o);
+}

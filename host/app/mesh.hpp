@@ -1,0 +1,34 @@
+// app/mesh.hpp — the scene's meshes, generated once on the CPU: a unit wall quad, the
+// icosphere lamp dome, the tumbler (round cone) and spheres, each in two levels of
+// detail. Indexed triangles; position + normal per vertex.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace kiln::app {
+
+struct Vertex {
+    glm::vec3 position;
+    glm::vec3 normal;
+};
+
+struct MeshData {
+    std::vector<Vertex> vertices;
+    std::vector<uint32_t> indices;
+};
+
+// The square [-1,1]² in the xz plane at y = 0, facing +y.
+MeshData makeQuad();
+// Icosphere of `radius` about `centre`, subdivided `level` times, keeping only the
+// triangles with a vertex below `clipY` (the part of the lamp inside the box). Normals
+// point outward (into the room).
+MeshData makeLampDome(glm::vec3 centre, float radius, int level, float clipY);
+MeshData makeUvSphere(int slices, int stacks);  // unit radius
+// A round cone: lower sphere radius b at the origin, upper sphere radius t at
+// (0, (b − t)/sin α, 0), joined by the tangent cone. `slices` around, `stacks` per cap.
+MeshData makeTumbler(float b, float t, float alpha, int slices, int stacks);
+
+}  // namespace kiln::app

@@ -1,0 +1,239 @@
+// The window front end: GLFW + Dear ImGui. The debug view is one function per panel,
+// each reading the host's state every frame (immediate mode, nothing to keep in sync).
+#include <GLFW/glfw3.h>
+#include <imgui.h>
+#include <backends/imgui_impl_glfw.h>
+#include <backends/imgui_impl_opengl3.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "app/app.hpp"
+#include "app/context.hpp"
+#include "kiln/log.hpp"
+
+namespace kiln::app {
+
+namespace {
+
+// How the selected texture is drawn to the screen (shaders/host/display.frag).
+struct DisplaySettings {
+    int channel = 0;        // 0 RGB, 1 R, 2 G, 3 B, 4 A
+    float rangeMin = 0.0f, rangeMax = 1.0f;
+    float exposure = 1.0f;
+    bool linearizeDepth = false;
+    int mip = 0;
+    float slice = 0.5f;     // 3D: normalised position along the axis
+    int axis = 2;           // 3D: 0 x, 1 y, 2 z
+};
+
+struct WindowState {
+    App* app = nullptr;
+    bool showDebug = true;
+    bool dragging = false;
+    double lastX = 0, lastY = 0;
+    DisplaySettings display;
+};
+
+void panelPasses(App& app) {
+    if (!ImGui::CollapsingHeader("Passes", ImGuiTreeNodeFlags_DefaultOpen)) return;
+    if (!ImGui::BeginTable("passes", 5, ImGuiTableFlags_RowBg | ImGuiTableFlags_BordersInnerV)) return;
+    ImGui::TableSetupColumn("pass");
+    ImGui::TableSetupColumn("module");
+    ImGui::TableSetupColumn("state");
+    ImGui::TableSetupColumn("GPU ms");
+    ImGui::TableSetupColumn("CPU ms");
+    ImGui::TableHeadersRow();
+    double gpuTotal = 0, cpuTotal = 0;
+    for (auto& r : app.runtime().stats()) {
+        ImGui::TableNextRow();
+        ImGui::TableNextColumn();
+        ImGui::TextUnformatted(r.id.c_str());
+        ImGui::TableNextColumn();
+        ImGui::TextUnformatted(r.module.c_str());
+        ImGui::TableNextColumn();
+        ImGui::TextUnformatted(r.state.c_str());
+        if (!r.why.empty() && ImGui::IsItemHovered()) ImGui::SetTooltip("%s", r.why.c_str());
+        ImGui::TableNextColumn();
+        if (r.gpuMs >= 0) ImGui::Text("%.3f", r.gpuMs), gpuTotal += r.gpuMs;
+        ImGui::TableNextColumn();
+        if (r.ranFrames) ImGui::Text("%.3f", r.cpuMs), cpuTotal += r.cpuMs;
+    }
+    ImGui::EndTable();
+    ImGui::Text("total: GPU %.2f ms, CPU %.2f ms (rolling average of the frames each pass ran)", gpuTotal, cpuTotal);
+}
+
+void panelTextures(App& app, DisplaySettings& d) {
+    if (!ImGui::CollapsingHeader("Textures", ImGuiTreeNodeFlags_DefaultOpen)) return;
+    const bool showingOutput = app.viewed.empty();
+    if (ImGui::RadioButton("graph output", showingOutput)) app.viewed.clear();
+    for (auto& t : app.runtime().textures()) {
+        std::string name = t.pass + "." + t.name;
+        std::string label = name + (t.internal ? " (internal)" : "") + "  " + std::to_string(t.ref.width) + "x" +
+                            std::to_string(t.ref.height) + (t.ref.target == GL_TEXTURE_3D ? "x" + std::to_string(t.ref.depth) : "") +
+                            " " + gl::formatName(t.ref.format);
+        if (ImGui::RadioButton(label.c_str(), app.viewed == name)) app.viewed = name;
+    }
+    const char* channels[] = {"RGB", "R", "G", "B", "A"};
+    ImGui::Combo("channel", &d.channel, channels, 5);
+    ImGui::DragFloatRange2("range", &d.rangeMin, &d.rangeMax, 0.01f, -100.0f, 100.0f);
+    ImGui::SliderFloat("exposure", &d.exposure, 0.01f, 16.0f, "%.2f", ImGuiSliderFlags_Logarithmic);
+    ImGui::Checkbox("linearize depth", &d.linearizeDepth);
+    ImGui::SliderInt("mip", &d.mip, 0, 10);
+    const char* axes[] = {"x", "y", "z"};
+    ImGui::Combo("3D axis", &d.axis, axes, 3);
+    ImGui::SliderFloat("3D slice", &d.slice, 0.0f, 1.0f);
+}
+
+void panelErrors(App& app) {
+    auto errors = app.runtime().activeErrors();
+    if (errors.empty()) return;
+    ImGui::SetNextWindowPos(ImVec2(10, ImGui::GetIO().DisplaySize.y - 10), ImGuiCond_Always, ImVec2(0, 1));
+    ImGui::SetNextWindowBgAlpha(0.85f);
+    ImGui::Begin("errors", nullptr, ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize);
+    for (auto& e : errors) ImGui::TextColored(ImVec4(1, 0.4f, 0.4f, 1), "%s", e.c_str());
+    ImGui::End();
+}
+
+void panelScene(App& app) {
+    if (!ImGui::CollapsingHeader("Scene", ImGuiTreeNodeFlags_DefaultOpen)) return;
+    ImGui::Checkbox("paused", &app.paused);
+    ImGui::SameLine();
+    if (ImGui::Button("step")) app.singleStep = true;
+    ImGui::Text("t = %.2f s", app.world().time());
+}
+
+GLuint buildDisplayProgram(const ShaderLibrary& shaders) {
+    ProgramBuild b = buildProgram(shaders, {{"common/fullscreen.vert", "host/display.frag"}, {}, "kiln.display"});
+    if (!b.ok()) {
+        log::error(b.errorText());
+        return 0;
+    }
+    return b.program.release();
+}
+
+void drawToScreen(GLuint program, const TextureRef& t, const DisplaySettings& d, int fbW, int fbH, GLuint vao) {
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glViewport(0, 0, fbW, fbH);
+    glClearColor(0.1f, 0.1f, 0.1f, 1);
+    glClear(GL_COLOR_BUFFER_BIT);
+    if (!program) return;
+    glUseProgram(program);
+    const bool is3d = t.target == GL_TEXTURE_3D;
+    glBindTextureUnit(is3d ? 1 : 0, t.id);
+    auto loc = [&](const char* n) { return glGetUniformLocation(program, n); };
+    glUniform1i(loc("u_is3d"), is3d);
+    glUniform1i(loc("u_channel"), d.channel);
+    glUniform2f(loc("u_range"), d.rangeMin, d.rangeMax);
+    glUniform1f(loc("u_exposure"), d.exposure);
+    const bool isDepth = t.format == GL_DEPTH_COMPONENT32F || t.format == GL_DEPTH_COMPONENT24;
+    glUniform1i(loc("u_linearizeDepth"), isDepth && d.linearizeDepth);
+    glUniform1f(loc("u_mip"), float(std::min(d.mip, t.levels - 1)));
+    glUniform1f(loc("u_slice"), d.slice);
+    glUniform1i(loc("u_axis"), d.axis);
+    glUniform1i(loc("u_isInteger"), t.format == GL_R32UI);
+    glBindVertexArray(vao);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glBindVertexArray(0);
+    glUseProgram(0);
+}
+
+}  // namespace
+
+int runWindow(const Options& o) {
+    std::string error;
+    auto context = WindowContext::create(o.width, o.height, "Kiln", true, error);
+    if (!context) {
+        std::fprintf(stderr, "kiln: error: %s; without a display use --headless (or run under xvfb-run)\n", error.c_str());
+        return 1;
+    }
+    log::info("window: ", context->description());
+    App app;
+    if (!app.init(o, error)) {
+        std::fprintf(stderr, "kiln: error: %s\n", error.c_str());
+        return 1;
+    }
+    WindowState state;
+    state.app = &app;
+    GLFWwindow* window = context->window();
+    glfwSetWindowUserPointer(window, &state);
+
+    glfwSetScrollCallback(window, [](GLFWwindow* w, double, double dy) {
+        if (ImGui::GetIO().WantCaptureMouse) return;
+        auto* s = static_cast<WindowState*>(glfwGetWindowUserPointer(w));
+        s->app->camera().distance = std::clamp(s->app->camera().distance * float(std::pow(0.9, dy)), 1.5f, 10.0f);
+    });
+    glfwSetKeyCallback(window, [](GLFWwindow* w, int key, int, int action, int) {
+        if (action != GLFW_PRESS || ImGui::GetIO().WantCaptureKeyboard) return;
+        auto* s = static_cast<WindowState*>(glfwGetWindowUserPointer(w));
+        if (key == GLFW_KEY_ESCAPE) glfwSetWindowShouldClose(w, 1);
+        if (key == GLFW_KEY_F1) s->showDebug = !s->showDebug;
+        if (key == GLFW_KEY_SPACE) s->app->paused = !s->app->paused;
+        if (key == GLFW_KEY_PERIOD) s->app->singleStep = true;
+    });
+    // Ours first: ImGui's GLFW backend chains to the callbacks it finds installed.
+    IMGUI_CHECKVERSION();
+    ImGui::CreateContext();
+    ImGui::GetIO().IniFilename = nullptr;
+    ImGui_ImplGlfw_InitForOpenGL(window, true);
+    ImGui_ImplOpenGL3_Init("#version 450 core");
+
+    GLuint displayProgram = buildDisplayProgram(app.runtime().shaders());
+    GLuint vao = 0;
+    glCreateVertexArrays(1, &vao);
+
+    int frames = 0;
+    while (!glfwWindowShouldClose(window)) {
+        glfwPollEvents();
+        // Orbit with the left mouse button on empty space.
+        double x, y;
+        glfwGetCursorPos(window, &x, &y);
+        const bool down = glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS;
+        if (down && !ImGui::GetIO().WantCaptureMouse) {
+            if (state.dragging) {
+                app.camera().yaw -= float(x - state.lastX) * 0.005f;
+                app.camera().pitch = std::clamp(app.camera().pitch + float(y - state.lastY) * 0.005f, -1.2f, 1.2f);
+            }
+            state.dragging = true;
+        } else {
+            state.dragging = false;
+        }
+        state.lastX = x, state.lastY = y;
+
+        app.frame();
+        int fbW, fbH;
+        glfwGetFramebufferSize(window, &fbW, &fbH);
+        if (const TextureRef* t = app.displayedTexture()) drawToScreen(displayProgram, *t, state.display, fbW, fbH, vao);
+
+        ImGui_ImplOpenGL3_NewFrame();
+        ImGui_ImplGlfw_NewFrame();
+        ImGui::NewFrame();
+        if (state.showDebug) {
+            ImGui::SetNextWindowPos(ImVec2(8, 8), ImGuiCond_FirstUseEver);
+            ImGui::SetNextWindowSize(ImVec2(420, 520), ImGuiCond_FirstUseEver);
+            ImGui::Begin("Kiln (F1)");
+            ImGui::Text("%s", app.runtime().pipelineFile().c_str());
+            panelPasses(app);
+            panelTextures(app, state.display);
+            panelScene(app);
+            ImGui::End();
+        }
+        panelErrors(app);
+        ImGui::Render();
+        ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+        glfwSwapBuffers(window);
+        ++frames;
+        if (const char* shot = std::getenv("KILN_SCREENSHOT_AFTER")) {
+            // For README screenshots under xvfb-run: capture the back buffer after N frames.
+            if (frames == std::atoi(shot)) glfwSetWindowShouldClose(window, 1);
+        }
+    }
+    glDeleteVertexArrays(1, &vao);
+    if (displayProgram) glDeleteProgram(displayProgram);
+    ImGui_ImplOpenGL3_Shutdown();
+    ImGui_ImplGlfw_Shutdown();
+    ImGui::DestroyContext();
+    return 0;
+}
+
+}  // namespace kiln::app

@@ -1,0 +1,91 @@
+#include "kiln/image_io.hpp"
+
+#include <stb_image_write.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+
+namespace kiln {
+
+FloatImage readTexture(GLuint texture, GLenum target, GLenum internalFormat, int width, int height, int level,
+                       int layer) {
+    FloatImage img;
+    img.width = std::max(1, width >> level);
+    img.height = std::max(1, height >> level);
+    img.channels = 4;
+    const size_t count = static_cast<size_t>(img.width) * img.height * 4;
+    img.pixels.assign(count, 0.0f);
+    const bool isDepth = internalFormat == GL_DEPTH_COMPONENT32F || internalFormat == GL_DEPTH_COMPONENT24;
+    const bool isUint = internalFormat == GL_R32UI;
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    if (isDepth || isUint) {
+        std::vector<float> one(static_cast<size_t>(img.width) * img.height);
+        std::vector<GLuint> ui(isUint ? one.size() : 0);
+        const int z = target == GL_TEXTURE_3D ? std::max(layer, 0) : 0;
+        if (isDepth)
+            glGetTextureSubImage(texture, level, 0, 0, z, img.width, img.height, 1, GL_DEPTH_COMPONENT, GL_FLOAT,
+                                 static_cast<GLsizei>(one.size() * sizeof(float)), one.data());
+        else
+            glGetTextureSubImage(texture, level, 0, 0, z, img.width, img.height, 1, GL_RED_INTEGER, GL_UNSIGNED_INT,
+                                 static_cast<GLsizei>(ui.size() * sizeof(GLuint)), ui.data());
+        for (size_t i = 0; i < one.size(); ++i) {
+            float v = isUint ? static_cast<float>(ui[i]) : one[i];
+            img.pixels[i * 4 + 0] = img.pixels[i * 4 + 1] = img.pixels[i * 4 + 2] = v;
+            img.pixels[i * 4 + 3] = 1.0f;
+        }
+        return img;
+    }
+    if (target == GL_TEXTURE_3D) {
+        glGetTextureSubImage(texture, level, 0, 0, std::max(layer, 0), img.width, img.height, 1, GL_RGBA, GL_FLOAT,
+                             static_cast<GLsizei>(count * sizeof(float)), img.pixels.data());
+    } else {
+        glGetTextureImage(texture, level, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(count * sizeof(float)),
+                          img.pixels.data());
+    }
+    return img;
+}
+
+bool writePng(const std::string& path, const FloatImage& img, int channels, std::string& error) {
+    channels = std::clamp(channels, 1, 4);
+    std::vector<unsigned char> bytes(static_cast<size_t>(img.width) * img.height * channels);
+    for (int y = 0; y < img.height; ++y) {
+        const int srcY = img.height - 1 - y;  // PNG is top-down
+        for (int x = 0; x < img.width; ++x) {
+            const float* p = img.at(x, srcY);
+            for (int c = 0; c < channels; ++c) {
+                float v = std::isfinite(p[c]) ? std::clamp(p[c], 0.0f, 1.0f) : 0.0f;
+                bytes[(static_cast<size_t>(y) * img.width + x) * channels + c] =
+                    static_cast<unsigned char>(std::lround(v * 255.0f));
+            }
+        }
+    }
+    if (!stbi_write_png(path.c_str(), img.width, img.height, channels, bytes.data(), img.width * channels)) {
+        error = path + ": cannot write PNG: " + std::strerror(errno);
+        return false;
+    }
+    return true;
+}
+
+bool writePfm(const std::string& path, const FloatImage& img, std::string& error) {
+    FILE* f = std::fopen(path.c_str(), "wb");
+    if (!f) {
+        error = path + ": cannot write: " + std::strerror(errno);
+        return false;
+    }
+    // PFM: bottom-to-top rows, negative scale = little endian. RGB only.
+    std::fprintf(f, "PF\n%d %d\n-1.0\n", img.width, img.height);
+    std::vector<float> row(static_cast<size_t>(img.width) * 3);
+    for (int y = 0; y < img.height; ++y) {
+        for (int x = 0; x < img.width; ++x)
+            for (int c = 0; c < 3; ++c) row[static_cast<size_t>(x) * 3 + c] = img.at(x, y)[c];
+        std::fwrite(row.data(), sizeof(float), row.size(), f);
+    }
+    const bool ok = std::fclose(f) == 0;
+    if (!ok) error = path + ": write failed";
+    return ok;
+}
+
+}  // namespace kiln

@@ -1,0 +1,270 @@
+#include "kiln/shader.hpp"
+
+#include <algorithm>
+#include <cstring>
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+#include "kiln/log.hpp"
+
+namespace fs = std::filesystem;
+
+namespace kiln {
+
+std::string ShaderError::toString() const {
+    std::string where = file.empty() ? "<shader>" : file;
+    if (line > 0) where += ":" + std::to_string(line);
+    return where + ": " + message;
+}
+
+std::string ProgramBuild::errorText() const {
+    std::string s;
+    for (auto& e : errors) s += e.toString() + "\n";
+    return s;
+}
+
+ShaderLibrary::ShaderLibrary(std::vector<fs::path> roots) {
+    for (auto& r : roots) {
+        std::error_code ec;
+        fs::path canon = fs::weakly_canonical(r, ec);
+        roots_.push_back(ec ? r : canon);
+    }
+}
+
+namespace {
+bool isInside(const fs::path& root, const fs::path& p) {
+    auto r = root.begin(), q = p.begin();
+    for (; r != root.end(); ++r, ++q)
+        if (q == p.end() || *r != *q) return false;
+    return true;
+}
+
+bool readFile(const fs::path& p, std::string& out) {
+    std::ifstream in(p, std::ios::binary);
+    if (!in) return false;
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    out = ss.str();
+    return true;
+}
+}  // namespace
+
+fs::path ShaderLibrary::resolve(const std::string& relative) const {
+    for (auto& root : roots_) {
+        std::error_code ec;
+        fs::path p = fs::weakly_canonical(root / relative, ec);
+        if (ec || !isInside(root, p)) continue;
+        if (fs::is_regular_file(p, ec)) return p;
+    }
+    return {};
+}
+
+std::string ShaderLibrary::displayPath(const fs::path& absolute) const {
+    for (auto& root : roots_)
+        if (isInside(root, absolute))
+            return (root.filename() / absolute.lexically_relative(root)).generic_string();
+    return absolute.generic_string();
+}
+
+namespace {
+struct Preprocessor {
+    const ShaderLibrary& lib;
+    PreprocessedSource& out;
+    ShaderError& error;
+    std::vector<fs::path> stack;
+
+    int fileId(const fs::path& p) {
+        std::string d = lib.displayPath(p);
+        auto it = std::find(out.files.begin(), out.files.end(), d);
+        if (it != out.files.end()) return static_cast<int>(it - out.files.begin());
+        out.files.push_back(d);
+        return static_cast<int>(out.files.size() - 1);
+    }
+
+    // Appends `file` to out.text; `header` (the #version + defines) goes right after
+    // the #version line of the top-level file.
+    bool include(const fs::path& file, const std::string* header) {
+        if (std::find(stack.begin(), stack.end(), file) != stack.end()) {
+            std::string chain;
+            for (auto& f : stack) chain += lib.displayPath(f) + " -> ";
+            chain += lib.displayPath(file);
+            error = {lib.displayPath(stack.back()), 0, "#include cycle: " + chain};
+            return false;
+        }
+        if (std::find(out.dependencies.begin(), out.dependencies.end(), file) != out.dependencies.end())
+            return true;  // included once per stage
+        std::string text;
+        if (!readFile(file, text)) {
+            error = {lib.displayPath(file), 0, "cannot read file"};
+            return false;
+        }
+        out.dependencies.push_back(file);
+        stack.push_back(file);
+        const int id = fileId(file);
+        std::istringstream lines(text);
+        std::string line;
+        int lineNo = 0;
+        bool sawVersion = header == nullptr;
+        static const std::regex includeRe(R"(^\s*#\s*include\s*(.*)$)");
+        static const std::regex quotedRe(R"re(^"([^"]+)"\s*(//.*)?$)re");
+        static const std::regex versionRe(R"(^\s*#\s*version\b.*)");
+        while (std::getline(lines, line)) {
+            ++lineNo;
+            if (!line.empty() && line.back() == '\r') line.pop_back();
+            std::smatch m;
+            if (!sawVersion && std::regex_match(line, versionRe)) {
+                out.text += line + "\n" + *header;
+                out.text += "#line " + std::to_string(lineNo + 1) + " " + std::to_string(id) + "\n";
+                sawVersion = true;
+                continue;
+            }
+            if (std::regex_match(line, m, includeRe)) {
+                std::string arg = m[1].str();
+                std::smatch q;
+                if (!std::regex_match(arg, q, quotedRe)) {
+                    error = {lib.displayPath(file), lineNo, "malformed #include (expected #include \"file\")"};
+                    return false;
+                }
+                const std::string name = q[1].str();
+                fs::path target;
+                std::error_code ec;
+                fs::path local = fs::weakly_canonical(file.parent_path() / name, ec);
+                bool insideRoots = false;
+                for (auto& r : lib.roots()) insideRoots |= isInside(r, local);
+                if (!ec && insideRoots && fs::is_regular_file(local, ec))
+                    target = local;
+                else
+                    target = lib.resolve(name);
+                if (target.empty()) {
+                    error = {lib.displayPath(file), lineNo, "#include \"" + name + "\": file not found in the shader roots"};
+                    return false;
+                }
+                out.text += "#line 1 " + std::to_string(fileId(target)) + "\n";
+                if (!include(target, nullptr)) return false;
+                out.text += "#line " + std::to_string(lineNo + 1) + " " + std::to_string(id) + "\n";
+                continue;
+            }
+            out.text += line + "\n";
+        }
+        if (!sawVersion) {
+            error = {lib.displayPath(file), 1, "no #version line"};
+            return false;
+        }
+        stack.pop_back();
+        return true;
+    }
+};
+}  // namespace
+
+bool ShaderLibrary::preprocess(const std::string& relativePath, const Defines& defines, PreprocessedSource& out,
+                               ShaderError& error) const {
+    out = {};
+    fs::path file = resolve(relativePath);
+    if (file.empty()) {
+        error = {relativePath, 0, "shader not found in the shader roots"};
+        return false;
+    }
+    std::string header;
+    for (auto& [k, v] : defines) header += "#define " + k + " " + v + "\n";
+    Preprocessor pp{*this, out, error, {}};
+    return pp.include(file, &header);
+}
+
+std::vector<ShaderError> mapInfoLog(const std::string& log, const std::vector<std::string>& files) {
+    std::vector<ShaderError> errors;
+    static const std::regex mesaRe(R"(^(\d+):(\d+)\(\d+\):\s*(.*)$)");
+    static const std::regex nvRe(R"(^(\d+)\((\d+)\)\s*:\s*(.*)$)");
+    std::istringstream lines(log);
+    std::string line;
+    while (std::getline(lines, line)) {
+        if (line.empty()) continue;
+        std::smatch m;
+        if (std::regex_match(line, m, mesaRe) || std::regex_match(line, m, nvRe)) {
+            size_t id = std::stoul(m[1].str());
+            errors.push_back({id < files.size() ? files[id] : "", std::stoi(m[2].str()), m[3].str()});
+        } else {
+            errors.push_back({files.empty() ? "" : files[0], 0, line});
+        }
+    }
+    return errors;
+}
+
+namespace {
+GLenum stageOf(const std::string& path) {
+    auto ext = fs::path(path).extension().string();
+    if (ext == ".vert") return GL_VERTEX_SHADER;
+    if (ext == ".frag") return GL_FRAGMENT_SHADER;
+    if (ext == ".geom") return GL_GEOMETRY_SHADER;
+    if (ext == ".comp") return GL_COMPUTE_SHADER;
+    if (ext == ".tesc") return GL_TESS_CONTROL_SHADER;
+    if (ext == ".tese") return GL_TESS_EVALUATION_SHADER;
+    return 0;
+}
+
+std::string infoLog(GLuint object, bool isProgram) {
+    GLint len = 0;
+    if (isProgram)
+        glGetProgramiv(object, GL_INFO_LOG_LENGTH, &len);
+    else
+        glGetShaderiv(object, GL_INFO_LOG_LENGTH, &len);
+    std::string s(static_cast<size_t>(std::max(len, 1)), '\0');
+    if (isProgram)
+        glGetProgramInfoLog(object, len, nullptr, s.data());
+    else
+        glGetShaderInfoLog(object, len, nullptr, s.data());
+    s.resize(std::strlen(s.c_str()));
+    return s;
+}
+}  // namespace
+
+ProgramBuild buildProgram(const ShaderLibrary& lib, const ProgramDesc& desc) {
+    ProgramBuild build;
+    std::vector<gl::ShaderHandle> shaders;
+    for (auto& stagePath : desc.stages) {
+        GLenum stage = stageOf(stagePath);
+        if (!stage) {
+            build.errors.push_back({stagePath, 0, "unknown shader stage (extension must be .vert .frag .geom .comp .tesc .tese)"});
+            continue;
+        }
+        PreprocessedSource src;
+        ShaderError err;
+        if (!lib.preprocess(stagePath, desc.defines, src, err)) {
+            build.errors.push_back(err);
+            for (auto& d : src.dependencies) build.dependencies.push_back(d);
+            continue;
+        }
+        for (auto& d : src.dependencies) build.dependencies.push_back(d);
+        gl::ShaderHandle sh(glCreateShader(stage));
+        const char* text = src.text.c_str();
+        glShaderSource(sh.id(), 1, &text, nullptr);
+        glCompileShader(sh.id());
+        GLint ok = 0;
+        glGetShaderiv(sh.id(), GL_COMPILE_STATUS, &ok);
+        if (!ok) {
+            auto errs = mapInfoLog(infoLog(sh.id(), false), src.files);
+            build.errors.insert(build.errors.end(), errs.begin(), errs.end());
+            continue;
+        }
+        shaders.push_back(std::move(sh));
+    }
+    if (!build.errors.empty()) return build;
+
+    gl::ProgramHandle program(glCreateProgram());
+    for (auto& sh : shaders) glAttachShader(program.id(), sh.id());
+    glLinkProgram(program.id());
+    for (auto& sh : shaders) glDetachShader(program.id(), sh.id());
+    GLint linked = 0;
+    glGetProgramiv(program.id(), GL_LINK_STATUS, &linked);
+    if (!linked) {
+        // Link errors carry no location; attribute them to the first stage.
+        build.errors.push_back({lib.displayPath(lib.resolve(desc.stages.front())), 0,
+                                "link failed: " + infoLog(program.id(), true)});
+        return build;
+    }
+    gl::label(GL_PROGRAM, program.id(), desc.debugName.empty() ? desc.stages.front() : desc.debugName);
+    build.program = std::move(program);
+    return build;
+}
+
+}  // namespace kiln

@@ -1,0 +1,154 @@
+// kiln/declare.hpp — what a pass *declares*: inputs, outputs, internal textures,
+// parameters, shader files and the scene categories it reads.
+//
+// This half of the pass ABI has no OpenGL in it, so the graph compiler (and its
+// tests) can validate a pipeline against declarations without a GL context. Pass
+// authors read the manual at the top of kiln/pass.hpp; this file is included from there.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <variant>
+#include <vector>
+
+namespace kiln {
+
+// Texture shapes a slot can hold. Depth is its own kind because a depth texture
+// cannot be bound where a colour texture is expected (and vice versa).
+enum class TextureKind : uint8_t { Color2D, Depth2D, Color3D };
+
+enum class Format : uint8_t {
+    RGBA8,      // albedo, LDR final image
+    RGBA16F,    // HDR colour, radiance
+    RGBA32F,
+    RG16F,
+    R16F,
+    R32F,
+    R11G11B10F,
+    R32UI,      // atomics (voxel accumulation)
+    Depth32F,
+    Depth24,
+};
+
+const char* toString(TextureKind);
+const char* toString(Format);
+bool isDepthFormat(Format);
+// Parses "rgba16f", "depth32f", ...; returns false on an unknown name.
+bool parseFormat(const std::string& name, Format& out);
+
+// What an optional input reads when nothing is bound to it. The shader also sees
+// `#define KILN_HAS_<INPUT> 0`, so it can skip the fetch altogether.
+enum class Fallback : uint8_t { Black, White, FlatNormal, FarDepth };
+const char* toString(Fallback);
+
+// How big an output or internal texture is.
+struct SizeRule {
+    enum class Mode : uint8_t {
+        RelativeToOutput,  // scale × the graph's output size (2D)
+        Fixed,             // width × height (× depth for 3D)
+        FromParam,         // a square (2D) or cube (3D) whose side is an int parameter
+    };
+    Mode mode = Mode::RelativeToOutput;
+    float scale = 1.0f;
+    int width = 0, height = 0, depth = 1;
+    std::string param;
+
+    static SizeRule relative(float s = 1.0f) { return {Mode::RelativeToOutput, s, 0, 0, 1, {}}; }
+    static SizeRule fixed(int w, int h, int d = 1) { return {Mode::Fixed, 1.0f, w, h, d, {}}; }
+    static SizeRule fromParam(std::string name) { return {Mode::FromParam, 1.0f, 0, 0, 1, std::move(name)}; }
+};
+
+// Mip count 1 = no mips; kFullMipChain = down to 1×1(×1).
+inline constexpr int kFullMipChain = 0;
+
+struct InputDecl {
+    std::string name;
+    TextureKind kind = TextureKind::Color2D;
+    bool required = true;
+    Fallback fallback = Fallback::Black;  // used only when !required and unbound
+    std::string doc;
+};
+
+struct TextureDecl {  // an output (bindable by later passes) or an internal texture
+    std::string name;
+    TextureKind kind = TextureKind::Color2D;
+    Format format = Format::RGBA16F;
+    SizeRule size = SizeRule::relative();
+    int mips = 1;
+    std::string doc;
+};
+
+enum class ParamType : uint8_t { Bool, Int, Float, Enum, Color };
+const char* toString(ParamType);
+
+using Color3 = std::array<float, 3>;
+using ParamValue = std::variant<bool, int, float, std::string, Color3>;
+
+struct ParamDecl {
+    std::string name;
+    ParamType type = ParamType::Float;
+    ParamValue def = 0.0f;
+    double min = 0.0, max = 0.0;          // Int/Float; min == max means unbounded
+    std::vector<std::string> choices;     // Enum; for Int, a non-empty list of allowed values
+    std::vector<int> intChoices;          //   (e.g. cone count 1, 5, 6, 9, 16)
+    std::string doc;
+};
+
+// Parts of the scene view a pass reads; the host re-runs a pass only when one of
+// these, its inputs or its parameters changed (unless it is time-dependent).
+enum SceneCategory : uint32_t {
+    kSceneNone = 0,
+    kSceneStatic = 1u << 0,     // Cornell box, lamp geometry
+    kSceneBodies = 1u << 1,     // tumblers, marbles, fireballs
+    kSceneParticles = 1u << 2,
+    kSceneLight = 1u << 3,
+    kSceneCamera = 1u << 4,
+    kSceneTime = 1u << 5,
+    kSceneAll = 0x3f,
+};
+
+struct PassDeclaration {
+    std::vector<InputDecl> inputs;
+    std::vector<TextureDecl> outputs;
+    std::vector<TextureDecl> internals;
+    std::vector<ParamDecl> params;
+    std::vector<std::string> shaders;   // paths relative to a shader root, for the watcher
+    uint32_t reads = kSceneNone;        // SceneCategory bits
+    bool timeDependent = false;         // run every frame regardless of versions
+
+    // Fluent helpers so a pass's declare() reads like a table.
+    PassDeclaration& input(InputDecl d) { inputs.push_back(std::move(d)); return *this; }
+    PassDeclaration& output(TextureDecl d) { outputs.push_back(std::move(d)); return *this; }
+    PassDeclaration& internal(TextureDecl d) { internals.push_back(std::move(d)); return *this; }
+    PassDeclaration& param(ParamDecl d) { params.push_back(std::move(d)); return *this; }
+    PassDeclaration& shader(std::string path) { shaders.push_back(std::move(path)); return *this; }
+};
+
+// Shorthands for the common declarations.
+inline ParamDecl floatParam(std::string name, float def, double lo, double hi, std::string doc = {}) {
+    ParamDecl p; p.name = std::move(name); p.type = ParamType::Float; p.def = def; p.min = lo; p.max = hi; p.doc = std::move(doc);
+    return p;
+}
+inline ParamDecl intParam(std::string name, int def, double lo, double hi, std::string doc = {}) {
+    ParamDecl p; p.name = std::move(name); p.type = ParamType::Int; p.def = def; p.min = lo; p.max = hi; p.doc = std::move(doc);
+    return p;
+}
+inline ParamDecl intChoiceParam(std::string name, int def, std::vector<int> allowed, std::string doc = {}) {
+    ParamDecl p; p.name = std::move(name); p.type = ParamType::Int; p.def = def; p.intChoices = std::move(allowed); p.doc = std::move(doc);
+    return p;
+}
+inline ParamDecl boolParam(std::string name, bool def, std::string doc = {}) {
+    ParamDecl p; p.name = std::move(name); p.type = ParamType::Bool; p.def = def; p.doc = std::move(doc);
+    return p;
+}
+inline ParamDecl enumParam(std::string name, std::string def, std::vector<std::string> choices, std::string doc = {}) {
+    ParamDecl p; p.name = std::move(name); p.type = ParamType::Enum; p.def = std::move(def); p.choices = std::move(choices); p.doc = std::move(doc);
+    return p;
+}
+inline ParamDecl colorParam(std::string name, Color3 def, std::string doc = {}) {
+    ParamDecl p; p.name = std::move(name); p.type = ParamType::Color; p.def = def; p.doc = std::move(doc);
+    return p;
+}
+
+}  // namespace kiln

@@ -1,0 +1,165 @@
+// kiln/pass.hpp — the pass ABI. This comment is the pass author's manual.
+//
+// WHAT A PASS IS
+//   A shared library (a "module") in build/modules/libpass_<name>.so that exports one
+//   C symbol, `kiln_pass_module`, returning a KilnPassModule descriptor. The host
+//   loads it by name when a pipeline file says `"module": "<name>"`, checks its ABI
+//   version before anything else, and creates one Pass object per pipeline entry.
+//   A pass owns code and shaders only: the host owns its textures, its parameter
+//   values and everything that must survive a reload of the module.
+//
+// WRITING ONE (passes/<name>/, two files)
+//   passes/<name>/CMakeLists.txt:   kiln_add_pass(<name> <name>.cpp)
+//   passes/<name>/<name>.cpp:
+//
+//     #include <kiln/pass.hpp>
+//     class Tint final : public kiln::Pass {
+//       kiln::PassDeclaration declare() const override {
+//         kiln::PassDeclaration d;
+//         d.input({.name = "color", .kind = kiln::TextureKind::Color2D})
+//          .output({.name = "color", .format = kiln::Format::RGBA16F})
+//          .param(kiln::colorParam("tint", {1, 0.5f, 0.5f}, "multiplies the colour"))
+//          .shader("tint/tint.frag");
+//         return d;
+//       }
+//       void execute(kiln::PassContext& ctx) override {
+//         GLuint prog = ctx.program({.stages = {"common/fullscreen.vert", "tint/tint.frag"}});
+//         if (!prog) return;                        // compile error: the host shows it
+//         glBindFramebuffer(GL_FRAMEBUFFER, ctx.framebuffer({"color"}));
+//         glUseProgram(prog);
+//         glBindTextureUnit(0, ctx.input("color").id);
+//         auto t = ctx.getColor("tint");
+//         glUniform3f(glGetUniformLocation(prog, "u_tint"), t[0], t[1], t[2]);
+//         ctx.drawFullscreenTriangle();
+//       }
+//     };
+//     KILN_PASS_MODULE(tint, Tint)
+//
+// DECLARING (see kiln/declare.hpp for every field)
+//   inputs     named slots a pipeline binds to "<pass id>.<output>"; kind Color2D,
+//              Depth2D or Color3D; required, or optional with a fallback texture
+//              (black / white / flat normal / far depth). An unbound optional input
+//              reaches your shaders as `#define KILN_HAS_<SLOT> 0` (1 when bound).
+//   outputs    format, 2D/3D, size rule (relative to the output size, fixed, or a
+//              side taken from an int parameter), mip count.
+//   internals  scratch textures (ping-pong, mip levels): allocated by the host, not
+//              bindable by other passes, listed in the debug view like outputs.
+//   params     name, type, default, range or choices: they drive the JSON validation
+//              and the debug UI. Read them in execute() with ctx.getFloat("name") etc.
+//   shaders    the files you use, relative to the shader roots (shaders/).
+//   reads      the scene categories you read (kSceneBodies, kSceneCamera, ...).
+//
+// SKIPPING
+//   The host re-runs a pass only when an input's version, a parameter, or a scene
+//   category it `reads` changed since its last run, or it is `timeDependent`.
+//   Otherwise its outputs keep their contents and the skip ripples down the graph.
+//   Inside execute(), ctx.nothingToDo("why") says the scene holds nothing for you
+//   (your outputs keep their contents and versions).
+//
+// EXECUTING
+//   ctx.input/output/internal("name") give TextureRef (GL name + shape). ctx.program()
+//   compiles (once, cached; recompiled on shader edits) and returns 0 if the shaders
+//   have an error, which the host reports as `shaders/x/y.frag:LINE: message`.
+//   ctx.framebuffer({"a","b"}, "depth") returns a cached FBO over your outputs.
+//   ctx.drawScene(filter) draws the scene's meshes instanced; your vertex shader
+//   includes "common/scene.glsl" for the attributes and the instance buffer.
+//   ctx.drawFullscreenTriangle() for screen passes (vertex shader
+//   "common/fullscreen.vert"). The frame uniforms (camera, light, output size, time)
+//   are bound as "common/frame.glsl" expects. The host wraps each pass in a KHR_debug
+//   group and times it (GPU timer query + CPU clock).
+//
+// RULES THAT KEEP RELOADING SAFE (see LIVE_EDITING in the README)
+//   No state in statics (a reload loses it); no thread_local with destructors; leave
+//   GL bindings as you like, the host resets the ones it relies on. Modules are built
+//   with -fvisibility=hidden -fno-gnu-unique by kiln_add_pass.
+#pragma once
+
+#include <cstdint>
+#include <initializer_list>
+#include <string>
+#include <string_view>
+#include <variant>
+
+#include "kiln/declare.hpp"
+#include "kiln/gl.hpp"
+#include "kiln/scene_view.hpp"
+#include "kiln/shader.hpp"
+
+namespace kiln {
+
+// Bump when anything in this header (or what it includes) changes layout or vtables.
+inline constexpr uint32_t kPassAbiVersion = 1;
+
+struct TextureRef {
+    GLuint id = 0;
+    GLenum target = 0;          // GL_TEXTURE_2D / GL_TEXTURE_3D
+    GLenum format = 0;          // internal format
+    int width = 0, height = 0, depth = 1, levels = 1;
+    bool bound = false;         // false: a fallback texture stands in
+};
+
+struct FrameInfo {
+    uint64_t index = 0;
+    double time = 0.0;          // simulation seconds
+    double dt = 0.0;
+    int outputWidth = 0, outputHeight = 0;
+};
+
+class PassContext {
+public:
+    virtual const TextureRef& input(std::string_view slot) const = 0;
+    virtual bool isBound(std::string_view slot) const = 0;
+    virtual const TextureRef& output(std::string_view name) const = 0;
+    virtual const TextureRef& internal(std::string_view name) const = 0;
+    virtual const ParamValue& param(std::string_view name) const = 0;
+    virtual const SceneView& scene() const = 0;
+    virtual const FrameInfo& frame() const = 0;
+
+    virtual GLuint program(const ProgramDesc& desc) = 0;
+    virtual GLuint framebuffer(std::initializer_list<std::string_view> colorTargets,
+                               std::string_view depthTarget = {}, int mipLevel = 0) = 0;
+    virtual void drawFullscreenTriangle() = 0;
+    virtual void drawScene(const DrawFilter& filter) = 0;
+    virtual void nothingToDo(std::string_view reason) = 0;
+    virtual void fail(std::string_view message) = 0;
+
+    float getFloat(std::string_view n) const { return std::get<float>(param(n)); }
+    int getInt(std::string_view n) const { return std::get<int>(param(n)); }
+    bool getBool(std::string_view n) const { return std::get<bool>(param(n)); }
+    const std::string& getEnum(std::string_view n) const { return std::get<std::string>(param(n)); }
+    Color3 getColor(std::string_view n) const { return std::get<Color3>(param(n)); }
+
+protected:
+    ~PassContext() = default;
+};
+
+class Pass {
+public:
+    virtual ~Pass() = default;
+    virtual PassDeclaration declare() const = 0;
+    virtual void execute(PassContext& ctx) = 0;
+};
+
+}  // namespace kiln
+
+extern "C" {
+// The layout of this struct's first field never changes, so a host can read the
+// ABI version of any module before trusting anything else in it.
+struct KilnPassModule {
+    uint32_t abiVersion;
+    const char* name;
+    kiln::Pass* (*create)();
+    void (*destroy)(kiln::Pass*);
+};
+}
+
+#define KILN_PASS_MODULE(NAME, CLASS)                                                        \
+    namespace {                                                                              \
+    kiln::Pass* kilnCreatePass() { return new CLASS(); }                                     \
+    void kilnDestroyPass(kiln::Pass* p) { delete p; }                                        \
+    const KilnPassModule kilnPassModule{kiln::kPassAbiVersion, #NAME, &kilnCreatePass,       \
+                                        &kilnDestroyPass};                                   \
+    }                                                                                        \
+    extern "C" __attribute__((visibility("default"))) const KilnPassModule* kiln_pass_module() { \
+        return &kilnPassModule;                                                              \
+    }

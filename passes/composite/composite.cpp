@@ -1,0 +1,48 @@
+// composite — the final image: direct light from the lamp on the G-buffer, plus
+// emission and (when bound) indirect light and bloom; tonemap and gamma.
+#include <kiln/pass.hpp>
+
+namespace {
+
+class Composite final : public kiln::Pass {
+public:
+    kiln::PassDeclaration declare() const override {
+        using namespace kiln;
+        PassDeclaration d;
+        d.input({.name = "albedo"})
+            .input({.name = "normal"})
+            .input({.name = "depth", .kind = TextureKind::Depth2D})
+            .input({.name = "emissive", .required = false, .fallback = Fallback::Black})
+            .input({.name = "shadow_map", .kind = TextureKind::Depth2D, .required = false})
+            .input({.name = "indirect", .required = false, .fallback = Fallback::Black})
+            .input({.name = "bloom", .required = false, .fallback = Fallback::Black})
+            .output({.name = "color", .format = Format::RGBA8, .doc = "tonemapped, gamma-encoded final image"})
+            .output({.name = "hdr", .format = Format::RGBA16F, .doc = "linear radiance before tonemapping"})
+            .param(floatParam("exposure", 1.0f, 0.01, 16.0, "scales radiance before tonemapping"))
+            .param(floatParam("ambient", 0.03f, 0.0, 1.0, "constant fill light when no indirect input is bound"))
+            .param(enumParam("tonemap", "aces", {"aces", "reinhard", "clamp"}))
+            .param(floatParam("gamma", 2.2f, 1.0, 3.0))
+            .shader("composite/composite.frag");
+        d.reads = kSceneLight | kSceneCamera;
+        return d;
+    }
+
+    void execute(kiln::PassContext& ctx) override {
+        GLuint program = ctx.program({.stages = {"common/fullscreen.vert", "composite/composite.frag"}});
+        if (!program) return;
+        if (!ctx.framebuffer({"color", "hdr"})) return;
+        glUseProgram(program);
+        const char* inputs[] = {"albedo", "normal", "depth", "emissive", "shadow_map", "indirect", "bloom"};
+        for (GLuint unit = 0; unit < 7; ++unit) glBindTextureUnit(unit, ctx.input(inputs[unit]).id);
+        const std::string& tonemap = ctx.getEnum("tonemap");
+        glUniform1f(glGetUniformLocation(program, "u_exposure"), ctx.getFloat("exposure"));
+        glUniform1f(glGetUniformLocation(program, "u_ambient"), ctx.getFloat("ambient"));
+        glUniform1f(glGetUniformLocation(program, "u_gamma"), ctx.getFloat("gamma"));
+        glUniform1i(glGetUniformLocation(program, "u_tonemap"), tonemap == "aces" ? 0 : tonemap == "reinhard" ? 1 : 2);
+        ctx.drawFullscreenTriangle();
+    }
+};
+
+}  // namespace
+
+KILN_PASS_MODULE(composite, Composite)

@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Installs every Debian package Kiln needs to build, run and test. Idempotent:
+# packages already present are left alone, so a second run costs one dpkg query.
+set -euo pipefail
+
+packages=(
+  build-essential cmake pkg-config ninja-build
+  python3-glad                       # glad 2: generates the GL loader at configure time
+  libglfw3-dev libimgui-dev          # window + debug view
+  libglm-dev nlohmann-json3-dev libstb-dev catch2
+  libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri libglx-mesa0   # EGL/GL + llvmpipe
+  xvfb xauth mesa-utils              # window tests/screenshots without a display
+  inotify-tools                      # used by live-reload test scripts
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+[ ${#missing[@]} -eq 0 ] && { echo "setup: all ${#packages[@]} packages present"; exit 0; }
+
+SUDO=""
+[ "$(id -u)" -eq 0 ] || SUDO="sudo"
+echo "setup: installing ${missing[*]}"
+$SUDO apt-get update -qq
+DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"

@@ -1,0 +1,12 @@
+// The per-frame uniforms the host binds for every pass (kiln/scene_view.hpp GpuFrame).
+layout(std140, binding = 0) uniform KilnFrame {
+    mat4 u_view;
+    mat4 u_proj;
+    mat4 u_viewProj;
+    mat4 u_invViewProj;
+    vec4 u_cameraPos;    // xyz
+    vec4 u_lightPos;     // xyz = lamp centre, w = lamp radius
+    vec4 u_lightColor;   // rgb × intensity, w = intensity
+    vec4 u_outputSize;   // w, h, 1/w, 1/h
+    vec4 u_time;         // seconds, dt, frame index
+};

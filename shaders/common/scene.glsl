@@ -1,0 +1,10 @@
+// Vertex inputs of drawScene() plus the frame uniforms and the instance buffer.
+// Include from a vertex shader that draws the scene's meshes.
+#include "frame.glsl"
+#include "instances.glsl"
+
+layout(location = 0) in vec3 a_position;
+layout(location = 1) in vec3 a_normal;
+layout(location = 2) in uint a_instance;   // index into kiln_instances
+
+KilnInstance kilnInstance() { return kiln_instances[a_instance]; }

@@ -1,0 +1,26 @@
+#version 450 core
+// G-buffer: albedo (sRGB-free linear rgb), world-space normal, emitted radiance.
+#include "common/frame.glsl"
+#include "common/instances.glsl"
+#include "common/wood.glsl"
+
+in vec3 v_world;
+in vec3 v_normal;
+flat in uint v_instance;
+
+layout(location = 0) out vec4 o_albedo;
+layout(location = 1) out vec4 o_normal;    // xyz world-space unit normal, w = 1 where geometry
+layout(location = 2) out vec4 o_emissive;  // rgb radiance
+
+void main() {
+    KilnInstance inst = kiln_instances[v_instance];
+    vec3 albedo = inst.albedo.rgb;
+    if (inst.albedo.a > 0.5) albedo = woodGrain(v_world, albedo);
+    vec3 n = normalize(v_normal);
+    if (!gl_FrontFacing) n = -n;
+    vec3 emissive = inst.emissive.rgb;
+    if (inst.emissive.a > 0.5) emissive += vec3(0.25, 0.2, 0.05);  // the picked tumbler glows
+    o_albedo = vec4(albedo, 1.0);
+    o_normal = vec4(n, 1.0);
+    o_emissive = vec4(emissive, 1.0);
+}
