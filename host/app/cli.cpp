@@ -2,6 +2,7 @@
 
 #include <charconv>
 #include <cstring>
+#include <filesystem>
 #include <string_view>
 
 namespace kiln::app {
@@ -39,6 +40,14 @@ bool parseInt(std::string_view s, long long& out) {
     return r.ec == std::errc() && r.ptr == s.data() + s.size();
 }
 }  // namespace
+
+void applyDefaults(Options& o) {
+    const std::filesystem::path source = KILN_SOURCE_DIR;
+    if (o.pipeline.empty()) o.pipeline = (source / "pipelines/default.json").string();
+    if (o.scene.empty()) o.scene = (source / "scenes/cornell.json").string();
+    if (o.shaderRoot.empty()) o.shaderRoot = (source / "shaders").string();
+    if (o.moduleDir.empty()) o.moduleDir = KILN_MODULE_DIR;
+}
 
 std::optional<Options> parseOptions(int argc, char** argv, std::string& error) {
     Options o;

@@ -31,5 +31,8 @@ extern const char* kUsage;
 
 // Parses argv; on a bad argument returns nullopt and sets `error` to one line.
 std::optional<Options> parseOptions(int argc, char** argv, std::string& error);
+// Fills unset paths: the source tree's pipelines/default.json, scenes/cornell.json,
+// shaders/, and the build's modules/ directory.
+void applyDefaults(Options&);
 
 }  // namespace kiln::app

@@ -24,14 +24,6 @@ int fail(const std::string& message) {
     return 1;
 }
 
-void fillDefaults(Options& o) {
-    const fs::path source = KILN_SOURCE_DIR;
-    if (o.pipeline.empty()) o.pipeline = (source / "pipelines/default.json").string();
-    if (o.scene.empty()) o.scene = (source / "scenes/cornell.json").string();
-    if (o.shaderRoot.empty()) o.shaderRoot = (source / "shaders").string();
-    if (o.moduleDir.empty()) o.moduleDir = KILN_MODULE_DIR;
-}
-
 int runHeadless(const Options& o) {
     std::string error;
     auto context = HeadlessContext::create(/*debug=*/true, error);
@@ -73,7 +65,7 @@ int main(int argc, char** argv) {
         std::printf("%s", kUsage);
         return 0;
     }
-    fillDefaults(o);
+    applyDefaults(o);
     if (o.headless) return runHeadless(o);
     return runWindow(o);
 }

@@ -16,7 +16,8 @@ int loadGL(GLADloadfunc getProc) {
 namespace {
 void GLAPIENTRY onDebugMessage(GLenum source, GLenum type, GLuint id, GLenum severity, GLsizei,
                                const GLchar* message, const void*) {
-    (void)source;
+    // Compile errors come back through buildProgram(), mapped to file:line.
+    if (source == GL_DEBUG_SOURCE_SHADER_COMPILER) return;
     if (severity == GL_DEBUG_SEVERITY_NOTIFICATION) return;
     if (type == GL_DEBUG_TYPE_PUSH_GROUP || type == GL_DEBUG_TYPE_POP_GROUP) return;
     const bool isError = type == GL_DEBUG_TYPE_ERROR || severity == GL_DEBUG_SEVERITY_HIGH;

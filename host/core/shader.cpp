@@ -82,6 +82,11 @@ struct Preprocessor {
         return static_cast<int>(out.files.size() - 1);
     }
 
+    void emit(const std::string& line, int file, int lineNo) {
+        out.text += line + "\n";
+        out.lines.push_back({file, lineNo});
+    }
+
     // Appends `file` to out.text; `header` (the #version + defines) goes right after
     // the #version line of the top-level file.
     bool include(const fs::path& file, const std::string* header) {
@@ -114,8 +119,10 @@ struct Preprocessor {
             if (!line.empty() && line.back() == '\r') line.pop_back();
             std::smatch m;
             if (!sawVersion && std::regex_match(line, versionRe)) {
-                out.text += line + "\n" + *header;
-                out.text += "#line " + std::to_string(lineNo + 1) + " " + std::to_string(id) + "\n";
+                emit(line, id, lineNo);
+                std::istringstream defines(*header);
+                std::string define;
+                while (std::getline(defines, define)) emit(define, id, lineNo);  // blamed on #version
                 sawVersion = true;
                 continue;
             }
@@ -140,12 +147,10 @@ struct Preprocessor {
                     error = {lib.displayPath(file), lineNo, "#include \"" + name + "\": file not found in the shader roots"};
                     return false;
                 }
-                out.text += "#line 1 " + std::to_string(fileId(target)) + "\n";
                 if (!include(target, nullptr)) return false;
-                out.text += "#line " + std::to_string(lineNo + 1) + " " + std::to_string(id) + "\n";
                 continue;
             }
-            out.text += line + "\n";
+            emit(line, id, lineNo);
         }
         if (!sawVersion) {
             error = {lib.displayPath(file), 1, "no #version line"};
@@ -171,7 +176,7 @@ bool ShaderLibrary::preprocess(const std::string& relativePath, const Defines& d
     return pp.include(file, &header);
 }
 
-std::vector<ShaderError> mapInfoLog(const std::string& log, const std::vector<std::string>& files) {
+std::vector<ShaderError> mapInfoLog(const std::string& log, const PreprocessedSource& src) {
     std::vector<ShaderError> errors;
     static const std::regex mesaRe(R"(^(\d+):(\d+)\(\d+\):\s*(.*)$)");
     static const std::regex nvRe(R"(^(\d+)\((\d+)\)\s*:\s*(.*)$)");
@@ -181,10 +186,17 @@ std::vector<ShaderError> mapInfoLog(const std::string& log, const std::vector<st
         if (line.empty()) continue;
         std::smatch m;
         if (std::regex_match(line, m, mesaRe) || std::regex_match(line, m, nvRe)) {
-            size_t id = std::stoul(m[1].str());
-            errors.push_back({id < files.size() ? files[id] : "", std::stoi(m[2].str()), m[3].str()});
+            // The source-string number is ignored: the driver gets one string and
+            // Mesa does not track it reliably anyway; the line table is exact.
+            const size_t at = std::stoul(m[2].str());
+            if (at >= 1 && at <= src.lines.size()) {
+                const SourceLine& where = src.lines[at - 1];
+                errors.push_back({src.files[static_cast<size_t>(where.file)], where.line, m[3].str()});
+            } else {
+                errors.push_back({src.files.empty() ? "" : src.files[0], 0, m[3].str()});
+            }
         } else {
-            errors.push_back({files.empty() ? "" : files[0], 0, line});
+            errors.push_back({src.files.empty() ? "" : src.files[0], 0, line});
         }
     }
     return errors;
@@ -242,7 +254,7 @@ ProgramBuild buildProgram(const ShaderLibrary& lib, const ProgramDesc& desc) {
         GLint ok = 0;
         glGetShaderiv(sh.id(), GL_COMPILE_STATUS, &ok);
         if (!ok) {
-            auto errs = mapInfoLog(infoLog(sh.id(), false), src.files);
+            auto errs = mapInfoLog(infoLog(sh.id(), false), src);
             build.errors.insert(build.errors.end(), errs.begin(), errs.end());
             continue;
         }

@@ -4,9 +4,11 @@
 // `#include "file.glsl"` resolves relative to the including file, then inside the
 // shader roots; nothing outside the roots is read. Each file is included once per
 // stage (like #pragma once); including a file that is already being included is a
-// cycle, reported with the chain. The host inserts `#line N <id>` around every
-// included file and maps the driver's `ID:LINE(COL): message` back to
-// `shaders/<dir>/<file>:LINE: message`.
+// cycle, reported with the chain. The expanded text keeps a table from each of its
+// lines to (file, line), and the driver's `0:LINE(COL): message` is mapped through it
+// to `shaders/<dir>/<file>:LINE: message`. (No `#line N <id>` directives: Mesa 22
+// reports source-string 0 for some errors inside included code, e.g. an undeclared
+// identifier, so the id cannot be trusted; the line over the whole text can.)
 #pragma once
 
 #include <filesystem>
@@ -27,9 +29,15 @@ struct ShaderError {
 
 using Defines = std::vector<std::pair<std::string, std::string>>;
 
+struct SourceLine {
+    int file = 0;  // index into PreprocessedSource::files
+    int line = 0;  // 1-based line in that file
+};
+
 struct PreprocessedSource {
     std::string text;                 // ready for glShaderSource
-    std::vector<std::string> files;   // source-string id → display path
+    std::vector<std::string> files;   // file index → display path
+    std::vector<SourceLine> lines;    // line of `text` (0-based) → where it came from
     std::vector<std::filesystem::path> dependencies;  // absolute paths of every file read
 };
 
@@ -52,9 +60,9 @@ private:
     std::vector<std::filesystem::path> roots_;
 };
 
-// Maps a driver info log through the source-string table (Mesa's `0:12(5): error: …`
-// and NVIDIA's `0(12) : error …`).
-std::vector<ShaderError> mapInfoLog(const std::string& log, const std::vector<std::string>& files);
+// Maps a driver info log (Mesa's `0:12(5): error: …`, NVIDIA's `0(12) : error …`)
+// through the line table of the text that was compiled.
+std::vector<ShaderError> mapInfoLog(const std::string& log, const PreprocessedSource& src);
 
 struct ProgramDesc {
     std::vector<std::string> stages;  // relative paths; stage from the extension

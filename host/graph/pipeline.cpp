@@ -1,0 +1,438 @@
+// Reading and writing pipeline files. Only this file and compiler.cpp's callers see
+// nlohmann; the headers stay free of it.
+#include "graph/pipeline.hpp"
+
+#include "graph/plan.hpp"  // formatParamValue
+#include "graph/suggest.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <cctype>
+#include <cstdlib>
+#include <limits>
+#include <set>
+
+namespace kiln::graph {
+
+using Json = nlohmann::ordered_json;  // keeps the file's key order (params, inputs)
+
+const char* toString(ParamLiteral::Type t) {
+    switch (t) {
+        case ParamLiteral::Type::Null: return "null";
+        case ParamLiteral::Type::Bool: return "bool";
+        case ParamLiteral::Type::Int: return "int";
+        case ParamLiteral::Type::Float: return "float";
+        case ParamLiteral::Type::String: return "string";
+        case ParamLiteral::Type::Array: return "array";
+        case ParamLiteral::Type::Object: return "object";
+    }
+    return "?";
+}
+
+int PipelineDesc::find(const std::string& id) const {
+    for (size_t i = 0; i < passes.size(); ++i)
+        if (passes[i].id == id) return static_cast<int>(i);
+    return -1;
+}
+
+void lineColumn(const std::string& text, size_t offset, int& line, int& column) {
+    line = 1;
+    column = 1;
+    const size_t end = std::min(offset, text.size());
+    for (size_t i = 0; i < end; ++i) {
+        if (text[i] == '\n') {
+            ++line;
+            column = 1;
+        } else {
+            ++column;
+        }
+    }
+}
+
+namespace {
+
+// JSON path of a key under `parent`: "passes[2].params.size"; keys that are not plain
+// identifiers are bracketed: params["my key"].
+std::string keyPath(const std::string& parent, const std::string& key) {
+    bool plain = !key.empty();
+    for (char c : key)
+        if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '$')) plain = false;
+    if (!plain) return parent + "[" + Json(key).dump() + "]";
+    return parent.empty() ? key : parent + "." + key;
+}
+
+std::string indexPath(const std::string& parent, size_t i) {
+    return parent + "[" + std::to_string(i) + "]";
+}
+
+const char* jsonTypeName(const Json& j) {
+    switch (j.type()) {
+        case Json::value_t::null: return "null";
+        case Json::value_t::boolean: return "bool";
+        case Json::value_t::number_integer:
+        case Json::value_t::number_unsigned: return "int";
+        case Json::value_t::number_float: return "float";
+        case Json::value_t::string: return "string";
+        case Json::value_t::array: return "array";
+        case Json::value_t::object: return "object";
+        default: return "value";
+    }
+}
+
+ParamLiteral toLiteral(const Json& j) {
+    ParamLiteral l;
+    l.text = j.dump();
+    switch (j.type()) {
+        case Json::value_t::boolean:
+            l.type = ParamLiteral::Type::Bool;
+            l.b = j.get<bool>();
+            break;
+        case Json::value_t::number_integer:
+            l.type = ParamLiteral::Type::Int;
+            l.i = j.get<int64_t>();
+            l.f = static_cast<double>(l.i);
+            break;
+        case Json::value_t::number_unsigned: {
+            const uint64_t u = j.get<uint64_t>();
+            l.type = ParamLiteral::Type::Int;
+            l.i = u > static_cast<uint64_t>(std::numeric_limits<int64_t>::max())
+                      ? std::numeric_limits<int64_t>::max()
+                      : static_cast<int64_t>(u);
+            l.f = static_cast<double>(u);
+            break;
+        }
+        case Json::value_t::number_float:
+            l.type = ParamLiteral::Type::Float;
+            l.f = j.get<double>();
+            break;
+        case Json::value_t::string:
+            l.type = ParamLiteral::Type::String;
+            l.s = j.get<std::string>();
+            break;
+        case Json::value_t::array:
+            l.type = ParamLiteral::Type::Array;
+            for (const Json& e : j) l.items.push_back(toLiteral(e));
+            break;
+        case Json::value_t::object: l.type = ParamLiteral::Type::Object; break;
+        default: l.type = ParamLiteral::Type::Null; break;
+    }
+    return l;
+}
+
+Json toJson(const ParamLiteral& l) {
+    switch (l.type) {
+        case ParamLiteral::Type::Bool: return l.b;
+        case ParamLiteral::Type::Int: return l.i;
+        case ParamLiteral::Type::Float: return l.f;
+        case ParamLiteral::Type::String: return l.s;
+        case ParamLiteral::Type::Array: {
+            Json a = Json::array();
+            for (const ParamLiteral& e : l.items) a.push_back(toJson(e));
+            return a;
+        }
+        case ParamLiteral::Type::Object:
+            // Kept as its text: an object is never a valid parameter, but writing back
+            // should not lose what the user wrote.
+            return Json::parse(l.text.empty() ? std::string("{}") : l.text, nullptr, false);
+        case ParamLiteral::Type::Null: break;
+    }
+    return nullptr;
+}
+
+// nlohmann silently keeps the last of two equal keys; a second "params" block that
+// wins over the first is a nasty surprise, so the parse callback reports it.
+class DuplicateKeyFinder {
+public:
+    explicit DuplicateKeyFinder(std::vector<std::string>& paths) : paths_(paths) {}
+
+    bool operator()(int /*depth*/, nlohmann::detail::parse_event_t event, Json& parsed) {
+        using E = nlohmann::detail::parse_event_t;
+        switch (event) {
+            case E::object_start: frames_.push_back({false, 0, {}, {}}); break;
+            case E::array_start: frames_.push_back({true, 0, {}, {}}); break;
+            case E::key: {
+                Frame& f = frames_.back();
+                f.key = parsed.is_string() ? parsed.get<std::string>() : std::string();
+                if (!f.keys.insert(f.key).second) paths_.push_back(currentPath());
+                break;
+            }
+            case E::object_end:
+            case E::array_end:
+                if (!frames_.empty()) frames_.pop_back();
+                finishValue();
+                break;
+            case E::value: finishValue(); break;
+        }
+        return true;
+    }
+
+private:
+    struct Frame {
+        bool array;
+        size_t index;
+        std::string key;
+        std::set<std::string> keys;
+    };
+
+    void finishValue() {
+        if (!frames_.empty() && frames_.back().array) ++frames_.back().index;
+    }
+
+    std::string currentPath() const {
+        std::string p;
+        for (const Frame& f : frames_) p = f.array ? indexPath(p, f.index) : keyPath(p, f.key);
+        return p;
+    }
+
+    std::vector<std::string>& paths_;
+    std::vector<Frame> frames_;
+};
+
+class Reader {
+public:
+    Reader(const std::string& file, std::vector<Diagnostic>& errors) : file_(file), errors_(errors) {}
+
+    void error(const std::string& path, std::string message) {
+        Diagnostic d;
+        d.file = file_;
+        d.path = path;
+        d.message = std::move(message);
+        errors_.push_back(std::move(d));
+    }
+
+    bool expect(const Json& j, Json::value_t type, const char* typeName, const std::string& path) {
+        if (j.type() == type) return true;
+        error(path, std::string("expected ") + typeName + ", got " + jsonTypeName(j) + " " + j.dump());
+        return false;
+    }
+
+    void unknownKey(const std::string& path, const std::string& key, const std::vector<std::string>& known) {
+        error(keyPath(path, key), "unknown key \"" + key + "\"" + suggestion(key, known, "keys"));
+    }
+
+    void readPass(const Json& j, const std::string& path, PassDesc& pass) {
+        static const std::vector<std::string> kKeys = {"id", "module", "enabled", "params", "inputs", "note"};
+        if (!j.is_object()) {
+            error(path, std::string("a pass is an object {\"id\": ..., \"module\": ...}, got ") + jsonTypeName(j));
+            return;
+        }
+        bool hasId = false, hasModule = false;
+        for (auto it = j.begin(); it != j.end(); ++it) {
+            const std::string& key = it.key();
+            const Json& v = it.value();
+            const std::string p = keyPath(path, key);
+            if (key == "id") {
+                hasId = true;
+                if (expect(v, Json::value_t::string, "string", p)) pass.id = v.get<std::string>();
+            } else if (key == "module") {
+                hasModule = true;
+                if (expect(v, Json::value_t::string, "string", p)) pass.module = v.get<std::string>();
+            } else if (key == "enabled") {
+                if (expect(v, Json::value_t::boolean, "bool", p)) pass.enabled = v.get<bool>();
+            } else if (key == "note") {
+                if (expect(v, Json::value_t::string, "string", p)) pass.note = v.get<std::string>();
+            } else if (key == "params") {
+                if (!expect(v, Json::value_t::object, "object", p)) continue;
+                for (auto pi = v.begin(); pi != v.end(); ++pi) pass.params.emplace_back(pi.key(), toLiteral(pi.value()));
+            } else if (key == "inputs") {
+                if (!expect(v, Json::value_t::object, "object", p)) continue;
+                for (auto ii = v.begin(); ii != v.end(); ++ii) {
+                    const std::string ip = keyPath(p, ii.key());
+                    if (!ii.value().is_string()) {
+                        error(ip, std::string("an input binding is a string \"<pass id>.<output>\", got ") +
+                                      jsonTypeName(ii.value()) + " " + ii.value().dump());
+                        continue;
+                    }
+                    pass.inputs.emplace_back(ii.key(), ii.value().get<std::string>());
+                }
+            } else {
+                unknownKey(path, key, kKeys);
+            }
+        }
+        if (!hasId) error(path, "missing \"id\" (a name for this pass, [a-z0-9_]+)");
+        if (!hasModule) error(path, "missing \"module\" (the pass module to run, e.g. \"gbuffer\")");
+    }
+
+    void readPipeline(const Json& root, PipelineDesc& desc) {
+        static const std::vector<std::string> kKeys = {"$schema", "note", "output", "passes"};
+        if (!root.is_object()) {
+            error("", std::string("a pipeline file is a JSON object {\"output\": ..., \"passes\": [...]}, got ") +
+                          jsonTypeName(root));
+            return;
+        }
+        bool hasPasses = false;
+        for (auto it = root.begin(); it != root.end(); ++it) {
+            const std::string& key = it.key();
+            const Json& v = it.value();
+            if (key == "$schema") {
+                if (expect(v, Json::value_t::string, "string", key)) desc.schema = v.get<std::string>();
+            } else if (key == "note") {
+                if (expect(v, Json::value_t::string, "string", key)) desc.note = v.get<std::string>();
+            } else if (key == "output") {
+                if (expect(v, Json::value_t::string, "string", key)) desc.output = v.get<std::string>();
+            } else if (key == "passes") {
+                hasPasses = true;
+                if (!expect(v, Json::value_t::array, "array", key)) continue;
+                desc.passes.resize(v.size());
+                for (size_t i = 0; i < v.size(); ++i) readPass(v[i], indexPath("passes", i), desc.passes[i]);
+            } else {
+                unknownKey("", key, kKeys);
+            }
+        }
+        if (!hasPasses) error("", "missing \"passes\" (the list of passes, in execution order)");
+    }
+
+private:
+    const std::string& file_;
+    std::vector<Diagnostic>& errors_;
+};
+
+// nlohmann's what(): "[json.exception.parse_error.101] parse error at line 3, column 5:
+// syntax error while parsing ..." — keep only the part after the position.
+std::string syntaxMessage(const std::string& what) {
+    const std::string marker = "parse error";
+    size_t p = what.find(marker);
+    if (p != std::string::npos) {
+        size_t colon = what.find(": ", p);
+        if (colon != std::string::npos) return what.substr(colon + 2);
+    }
+    return what;
+}
+
+// nlohmann reports the *last* byte it read, i.e. the end of the offending token
+// ("module" in `"x" "module"`); editors want its start. Scan tokens from the top
+// (strings with escapes, bare words/numbers, punctuation) to find the one that holds
+// `at`. Returns `at` itself when it is not inside a token.
+size_t tokenStart(const std::string& text, size_t at) {
+    size_t i = 0;
+    while (i < text.size() && i <= at) {
+        const char c = text[i];
+        size_t end = i + 1;
+        if (c == '"') {
+            while (end < text.size() && text[end] != '"' && text[end] != '\n') end += text[end] == '\\' ? 2 : 1;
+            ++end;  // the closing quote
+        } else if (std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '+' || c == '.') {
+            while (end < text.size() && (std::isalnum(static_cast<unsigned char>(text[end])) || text[end] == '.' ||
+                                         text[end] == '-' || text[end] == '+'))
+                ++end;
+        } else if (std::isspace(static_cast<unsigned char>(c))) {
+            if (at == i) return at;
+        }
+        if (at >= i && at < end) return i;
+        i = end;
+    }
+    return at;
+}
+
+// dump(2) puts every array element on its own line; a colour reads better as
+// [1, 0.9, 0.8]. Arrays without nested arrays/objects/strings are put on one line.
+std::string collapseFlatArrays(const std::string& text) {
+    std::string out;
+    out.reserve(text.size());
+    size_t i = 0;
+    while (i < text.size()) {
+        if (text[i] == '"') {  // copy strings verbatim
+            size_t end = i + 1;
+            while (end < text.size() && text[end] != '"') end += text[end] == '\\' ? 2 : 1;
+            out.append(text, i, end + 1 - i);
+            i = end + 1;
+            continue;
+        }
+        if (text[i] == '[') {
+            const size_t close = text.find_first_of("[]{}\"", i + 1);
+            if (close != std::string::npos && text[close] == ']') {
+                std::string flat = "[";
+                bool space = false;
+                for (size_t k = i + 1; k < close; ++k) {
+                    if (std::isspace(static_cast<unsigned char>(text[k]))) {
+                        space = true;
+                        continue;
+                    }
+                    if (space && flat.back() == ',') flat += ' ';
+                    space = false;
+                    flat += text[k];
+                }
+                out += flat + "]";
+                i = close + 1;
+                continue;
+            }
+        }
+        out += text[i++];
+    }
+    return out;
+}
+
+}  // namespace
+
+ParamLiteral ParamLiteral::of(const ParamValue& v) {
+    Json j;
+    if (const bool* b = std::get_if<bool>(&v)) j = *b;
+    else if (const int* i = std::get_if<int>(&v)) j = *i;
+    // Floats go through their shortest decimal form, so 0.9f is written as 0.9, not
+    // as the double 0.89999997615814209.
+    else if (const float* f = std::get_if<float>(&v)) j = std::strtod(formatParamValue(*f).c_str(), nullptr);
+    else if (const std::string* s = std::get_if<std::string>(&v)) j = *s;
+    else if (const Color3* c = std::get_if<Color3>(&v))
+        j = Json::array({std::strtod(formatParamValue((*c)[0]).c_str(), nullptr),
+                         std::strtod(formatParamValue((*c)[1]).c_str(), nullptr),
+                         std::strtod(formatParamValue((*c)[2]).c_str(), nullptr)});
+    return toLiteral(j);
+}
+
+Result<PipelineDesc> parsePipeline(const std::string& text, const std::string& fileName) {
+    std::vector<Diagnostic> errors;
+    std::vector<std::string> duplicates;
+    Json root;
+    try {
+        DuplicateKeyFinder finder(duplicates);
+        root = Json::parse(text, std::ref(finder), /*allow_exceptions=*/true, /*ignore_comments=*/false);
+    } catch (const Json::parse_error& e) {
+        Diagnostic d;
+        d.file = fileName;
+        // e.byte is 1-based: the last character read, i.e. the offending one.
+        const size_t at = tokenStart(text, e.byte > 0 ? e.byte - 1 : 0);
+        lineColumn(text, at, d.line, d.column);
+        d.message = syntaxMessage(e.what());
+        if (at < text.size() && text[at] == '/')
+            d.message += " (comments are not JSON: put prose in a \"note\" field)";
+        return Result<PipelineDesc>(std::move(d));
+    }
+
+    PipelineDesc desc;
+    desc.fileName = fileName;
+    Reader reader(fileName, errors);
+    for (const std::string& p : duplicates) reader.error(p, "duplicate key: only the last one would count");
+    reader.readPipeline(root, desc);
+    if (!errors.empty()) return Result<PipelineDesc>(std::move(errors));
+    return Result<PipelineDesc>(std::move(desc));
+}
+
+std::string writePipeline(const PipelineDesc& desc) {
+    Json root = Json::object();
+    if (!desc.schema.empty()) root["$schema"] = desc.schema;
+    if (!desc.note.empty()) root["note"] = desc.note;
+    root["output"] = desc.output;
+    Json passes = Json::array();
+    for (const PassDesc& p : desc.passes) {
+        Json j = Json::object();
+        j["id"] = p.id;
+        j["module"] = p.module;
+        if (!p.enabled) j["enabled"] = false;
+        if (!p.note.empty()) j["note"] = p.note;
+        if (!p.params.empty()) {
+            Json params = Json::object();
+            for (const auto& [name, value] : p.params) params[name] = toJson(value);
+            j["params"] = std::move(params);
+        }
+        if (!p.inputs.empty()) {
+            Json inputs = Json::object();
+            for (const auto& [slot, binding] : p.inputs) inputs[slot] = binding;
+            j["inputs"] = std::move(inputs);
+        }
+        passes.push_back(std::move(j));
+    }
+    root["passes"] = std::move(passes);
+    return collapseFlatArrays(root.dump(2)) + "\n";
+}
+
+}  // namespace kiln::graph

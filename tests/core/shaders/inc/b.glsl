@@ -1,0 +1,1 @@
+vec3 b() { return vec3(1.0); }

@@ -1,0 +1,2 @@
+// back to the first: a cycle
+#include "cycle_1.glsl"

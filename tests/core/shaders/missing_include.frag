@@ -1,0 +1,3 @@
+#version 450 core
+#include "inc/missing.glsl"
+void main() {}

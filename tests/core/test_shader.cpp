@@ -1,0 +1,85 @@
+#include <catch2/catch.hpp>
+
+#include "kiln/shader.hpp"
+#include "support/headless.hpp"
+
+using namespace kiln;
+
+namespace {
+ShaderLibrary library() { return ShaderLibrary({TEST_SHADER_DIR}); }
+}  // namespace
+
+TEST_CASE("shader includes: nested, relative to the including file, each once", "[shader]") {
+    PreprocessedSource src;
+    ShaderError err;
+    REQUIRE(library().preprocess("nested.frag", {{"FOO", "1"}}, src, err));
+    CHECK(src.dependencies.size() == 3);
+    // The define lands after #version, before any code.
+    CHECK(src.text.find("#version 450 core\n#define FOO 1\n") == 0);
+    CHECK(src.text.find("vec3 b()") < src.text.find("vec3 a()"));
+    CHECK(src.files == std::vector<std::string>{"shaders/nested.frag", "shaders/inc/a.glsl", "shaders/inc/b.glsl"});
+}
+
+TEST_CASE("shader includes: a cycle is an error naming the chain", "[shader]") {
+    PreprocessedSource src;
+    ShaderError err;
+    REQUIRE_FALSE(library().preprocess("cycle.frag", {}, src, err));
+    CHECK_THAT(err.message, Catch::Contains("#include cycle"));
+    CHECK_THAT(err.message,
+               Catch::Contains("shaders/inc/cycle_1.glsl -> shaders/inc/cycle_2.glsl -> shaders/inc/cycle_1.glsl"));
+}
+
+TEST_CASE("shader includes: a missing include names the including file and line", "[shader]") {
+    PreprocessedSource src;
+    ShaderError err;
+    REQUIRE_FALSE(library().preprocess("missing_include.frag", {}, src, err));
+    CHECK(err.toString() == "shaders/missing_include.frag:2: #include \"inc/missing.glsl\": file not found in the shader roots");
+}
+
+TEST_CASE("shader includes: a path leaving the shader roots is refused", "[shader]") {
+    PreprocessedSource src;
+    ShaderError err;
+    REQUIRE_FALSE(library().preprocess("escape.frag", {}, src, err));
+    CHECK_THAT(err.toString(), Catch::Contains("escape.frag:2"));
+    CHECK(library().resolve("../test_shader.cpp").empty());
+}
+
+TEST_CASE("mapInfoLog maps Mesa's and NVIDIA's formats through the line table", "[shader]") {
+    PreprocessedSource src;
+    ShaderError err;
+    REQUIRE(library().preprocess("nested.frag", {{"A", "1"}, {"B", "2"}}, src, err));
+    // Expanded: #version, 2 defines, a.glsl:1, b.glsl:1, a.glsl:3, ...
+    REQUIRE(src.lines.size() > 5);
+    auto e = mapInfoLog("0:5(5): error: `x' undeclared\n0(6) : error C1008: undefined variable\nlink trouble\n", src);
+    REQUIRE(e.size() == 3);
+    CHECK(e[0].toString() == "shaders/inc/b.glsl:1: error: `x' undeclared");
+    CHECK(e[1].toString() == "shaders/inc/a.glsl:3: error C1008: undefined variable");
+    CHECK(e[2].line == 0);
+}
+
+TEST_CASE("a compile error inside an included file points at that file and line", "[shader][gl]") {
+    REQUIRE(test::ensureHeadlessContext());
+    ProgramBuild b = buildProgram(library(), {{"error_in_include.frag"}, {}, "test"});
+    REQUIRE_FALSE(b.ok());
+    REQUIRE_FALSE(b.errors.empty());
+    CHECK(b.errors[0].file == "shaders/inc/broken.glsl");
+    CHECK(b.errors[0].line == 4);
+    CHECK_THAT(b.errors[0].message, Catch::Contains("undefined_symbol"));
+}
+
+TEST_CASE("a compile error in the main file keeps its own line numbers after includes", "[shader][gl]") {
+    REQUIRE(test::ensureHeadlessContext());
+    ProgramBuild b = buildProgram(library(), {{"error_in_main.frag"}, {}, "test"});
+    REQUIRE_FALSE(b.ok());
+    CHECK(b.errors[0].file == "shaders/error_in_main.frag");
+    CHECK(b.errors[0].line == 5);  // the undeclared name is on line 5
+}
+
+TEST_CASE("a valid program with nested includes compiles and links", "[shader][gl]") {
+    REQUIRE(test::ensureHeadlessContext());
+    ProgramBuild b = buildProgram(ShaderLibrary({TEST_SHADER_DIR, KILN_SOURCE_DIR "/shaders"}),
+                                  {{"common/fullscreen.vert", "nested.frag"}, {}, "test"});
+    INFO(b.errorText());
+    CHECK(b.ok());
+    CHECK(b.dependencies.size() == 4);
+}
