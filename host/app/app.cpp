@@ -38,6 +38,13 @@ bool App::init(const Options& o, std::string& error) {
     return true;
 }
 
+void App::resize(int width, int height) {
+    if (width < 1 || height < 1 || (width == options_.width && height == options_.height)) return;
+    options_.width = width;
+    options_.height = height;
+    runtime_.resize(width, height);
+}
+
 SceneView App::buildView() const {
     SceneView v;
     const int w = options_.width, h = options_.height;

@@ -20,6 +20,8 @@ public:
     // The graph output, or the texture chosen with --view / in the debug view.
     const TextureRef* displayedTexture() const;
 
+    // The window's framebuffer changed size: reallocate size-relative textures.
+    void resize(int width, int height);
     Runtime& runtime() { return runtime_; }
     World& world() { return world_; }
     OrbitCamera& camera() { return camera_; }

@@ -23,6 +23,8 @@ usage: kiln [options]
   --plan            print the compiled plan (order, culled passes and why)
   --dot FILE        write the plan as graphviz dot
   --view PASS.OUT   show this texture instead of the graph output (un-culls its producer)
+  --screenshot F    window mode: save the window (debug view included) after
+                    --frames frames, then quit
   --seed N          simulation seed (same seed, same frames)
   --paused          do not advance the simulation
   --shaders DIR     shader root (default shaders/)
@@ -73,7 +75,7 @@ std::optional<Options> parseOptions(int argc, char** argv, std::string& error) {
         } else if (a == "--paused") {
             o.paused = true;
         } else if (a == "--pipeline" || a == "--scene" || a == "--out" || a == "--dump" || a == "--dot" ||
-                   a == "--shaders" || a == "--modules" || a == "--view") {
+                   a == "--shaders" || a == "--modules" || a == "--view" || a == "--screenshot") {
             auto v = value(a);
             if (!v) return std::nullopt;
             std::string* dst = a == "--pipeline" ? &o.pipeline
@@ -83,6 +85,7 @@ std::optional<Options> parseOptions(int argc, char** argv, std::string& error) {
                              : a == "--dot"      ? &o.dot
                              : a == "--shaders"  ? &o.shaderRoot
                              : a == "--modules"  ? &o.moduleDir
+                             : a == "--screenshot" ? &o.screenshot
                                                  : &o.view;
             *dst = *v;
         } else if (a == "--size") {

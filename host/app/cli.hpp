@@ -24,6 +24,7 @@ struct Options {
     uint64_t seed = 1;
     bool paused = false;      // freeze the simulation (time stays at 0 + frames×0)
     bool help = false;
+    std::string screenshot;   // window: save the window after --frames frames and quit
     std::string view;         // "pass.output" to show instead of the graph output
 };
 

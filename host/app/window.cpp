@@ -10,6 +10,7 @@
 
 #include "app/app.hpp"
 #include "app/context.hpp"
+#include "kiln/image_io.hpp"
 #include "kiln/log.hpp"
 
 namespace kiln::app {
@@ -200,9 +201,10 @@ int runWindow(const Options& o) {
         }
         state.lastX = x, state.lastY = y;
 
-        app.frame();
         int fbW, fbH;
         glfwGetFramebufferSize(window, &fbW, &fbH);
+        app.resize(fbW, fbH);
+        app.frame();
         if (const TextureRef* t = app.displayedTexture()) drawToScreen(displayProgram, *t, state.display, fbW, fbH, vao);
 
         ImGui_ImplOpenGL3_NewFrame();
@@ -221,12 +223,20 @@ int runWindow(const Options& o) {
         panelErrors(app);
         ImGui::Render();
         ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
-        glfwSwapBuffers(window);
         ++frames;
-        if (const char* shot = std::getenv("KILN_SCREENSHOT_AFTER")) {
-            // For README screenshots under xvfb-run: capture the back buffer after N frames.
-            if (frames == std::atoi(shot)) glfwSetWindowShouldClose(window, 1);
+        if (!o.screenshot.empty() && frames == o.frames) {
+            // The whole window, debug view included (README screenshots under xvfb-run).
+            FloatImage img;
+            img.width = fbW, img.height = fbH;
+            img.pixels.resize(size_t(fbW) * fbH * 4);
+            glReadBuffer(GL_BACK);
+            glReadPixels(0, 0, fbW, fbH, GL_RGBA, GL_FLOAT, img.pixels.data());
+            std::string error;
+            if (!writePng(o.screenshot, img, 3, error)) log::error(error);
+            else log::info("wrote ", o.screenshot);
+            glfwSetWindowShouldClose(window, 1);
         }
+        glfwSwapBuffers(window);
     }
     glDeleteVertexArrays(1, &vao);
     if (displayProgram) glDeleteProgram(displayProgram);
