@@ -69,6 +69,7 @@ public:
     const TextureRef* findTexture(std::string_view pass, std::string_view name) const;
     const graph::Plan* plan() const { return plan_ ? &*plan_ : nullptr; }
     const std::string& pipelineFile() const { return pipelineFile_; }
+    const std::string& pipelineText() const { return pipelineText_; }
     std::vector<PassRow> stats() const;
     std::string statsTable() const;
 

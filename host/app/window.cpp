@@ -7,6 +7,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
+
+#include "graph/pipeline.hpp"
 
 #include "app/app.hpp"
 #include "app/context.hpp"
@@ -28,15 +31,103 @@ struct DisplaySettings {
     int axis = 2;           // 3D: 0 x, 1 y, 2 z
 };
 
-struct WindowState {
-    App* app = nullptr;
-    bool showDebug = true;
-    bool dragging = false;
-    double lastX = 0, lastY = 0;
-    DisplaySettings display;
+
+// Applies an edit of the running pipeline (a toggle, a parameter) by recompiling
+// the edited description; the pipeline file itself changes only on "write back".
+struct PipelineEditor {
+    std::string error;
+    std::string selected;  // pass id whose parameters are shown
+
+    bool apply(App& app, const std::function<void(graph::PipelineDesc&)>& edit) {
+        Runtime& rt = app.runtime();
+        auto desc = graph::parsePipeline(rt.pipelineText(), rt.pipelineFile());
+        if (!desc) {
+            error = desc.errorText();
+            return false;
+        }
+        edit(*desc);
+        std::string errors;
+        if (!rt.loadPipelineText(graph::writePipeline(*desc), rt.pipelineFile(), errors)) {
+            error = errors;  // the running plan stays
+            return false;
+        }
+        error.clear();
+        return true;
+    }
 };
 
-void panelPasses(App& app) {
+void setParam(graph::PassDesc& pass, const std::string& name, const ParamValue& value) {
+    auto literal = graph::ParamLiteral::of(value);
+    for (auto& [k, v] : pass.params)
+        if (k == name) {
+            v = literal;
+            return;
+        }
+    pass.params.emplace_back(name, literal);
+}
+
+void panelParams(App& app, PipelineEditor& editor) {
+    const graph::Plan* plan = app.runtime().plan();
+    if (!plan) return;
+    int index = plan->find(editor.selected);
+    if (index < 0) return;
+    const graph::PlannedPass& pass = plan->passes[static_cast<size_t>(index)];
+    ImGui::Separator();
+    ImGui::Text("%s parameters", pass.id.c_str());
+    for (auto& decl : pass.decl.params) {
+        const ParamValue* current = pass.params.find(decl.name);
+        if (!current) continue;
+        ParamValue edited = *current;
+        bool changed = false;
+        const char* label = decl.name.c_str();
+        const bool bounded = decl.max > decl.min;
+        switch (decl.type) {
+            case ParamType::Bool: changed = ImGui::Checkbox(label, &std::get<bool>(edited)); break;
+            case ParamType::Int:
+                if (!decl.intChoices.empty()) {
+                    int& v = std::get<int>(edited);
+                    if (ImGui::BeginCombo(label, std::to_string(v).c_str())) {
+                        for (int c : decl.intChoices)
+                            if (ImGui::Selectable(std::to_string(c).c_str(), c == v)) v = c, changed = true;
+                        ImGui::EndCombo();
+                    }
+                } else if (bounded) {
+                    changed = ImGui::SliderInt(label, &std::get<int>(edited), int(decl.min), int(decl.max));
+                } else {
+                    changed = ImGui::InputInt(label, &std::get<int>(edited));
+                }
+                break;
+            case ParamType::Float:
+                changed = bounded ? ImGui::SliderFloat(label, &std::get<float>(edited), float(decl.min), float(decl.max))
+                                  : ImGui::DragFloat(label, &std::get<float>(edited), 0.01f);
+                break;
+            case ParamType::Enum: {
+                std::string& v = std::get<std::string>(edited);
+                if (ImGui::BeginCombo(label, v.c_str())) {
+                    for (auto& c : decl.choices)
+                        if (ImGui::Selectable(c.c_str(), c == v)) v = c, changed = true;
+                    ImGui::EndCombo();
+                }
+                break;
+            }
+            case ParamType::Color: changed = ImGui::ColorEdit3(label, std::get<Color3>(edited).data()); break;
+        }
+        if (!decl.doc.empty() && ImGui::IsItemHovered()) ImGui::SetTooltip("%s", decl.doc.c_str());
+        if (changed)
+            editor.apply(app, [&](graph::PipelineDesc& d) { setParam(d.passes[size_t(d.find(pass.id))], decl.name, edited); });
+    }
+    if (ImGui::Button("write back to the pipeline file")) {
+        std::FILE* f = std::fopen(app.runtime().pipelineFile().c_str(), "w");
+        if (!f) {
+            editor.error = app.runtime().pipelineFile() + ": cannot write";
+        } else {
+            std::fputs(app.runtime().pipelineText().c_str(), f);
+            std::fclose(f);
+        }
+    }
+}
+
+void panelPasses(App& app, PipelineEditor& editor) {
     if (!ImGui::CollapsingHeader("Passes", ImGuiTreeNodeFlags_DefaultOpen)) return;
     if (!ImGui::BeginTable("passes", 5, ImGuiTableFlags_RowBg | ImGuiTableFlags_BordersInnerV)) return;
     ImGui::TableSetupColumn("pass");
@@ -46,10 +137,20 @@ void panelPasses(App& app) {
     ImGui::TableSetupColumn("CPU ms");
     ImGui::TableHeadersRow();
     double gpuTotal = 0, cpuTotal = 0;
+    const graph::Plan* plan = app.runtime().plan();
     for (auto& r : app.runtime().stats()) {
         ImGui::TableNextRow();
         ImGui::TableNextColumn();
-        ImGui::TextUnformatted(r.id.c_str());
+        int index = plan ? plan->find(r.id) : -1;
+        bool enabled = index >= 0 && plan->passes[size_t(index)].state != graph::PassState::Disabled;
+        ImGui::PushID(r.id.c_str());
+        if (ImGui::Checkbox("##on", &enabled))
+            editor.apply(app, [&](graph::PipelineDesc& d) {
+                if (int i = d.find(r.id); i >= 0) d.passes[size_t(i)].enabled = enabled;
+            });
+        ImGui::SameLine();
+        if (ImGui::Selectable(r.id.c_str(), editor.selected == r.id)) editor.selected = r.id;
+        ImGui::PopID();
         ImGui::TableNextColumn();
         ImGui::TextUnformatted(r.module.c_str());
         ImGui::TableNextColumn();
@@ -61,7 +162,9 @@ void panelPasses(App& app) {
         if (r.ranFrames) ImGui::Text("%.3f", r.cpuMs), cpuTotal += r.cpuMs;
     }
     ImGui::EndTable();
-    ImGui::Text("total: GPU %.2f ms, CPU %.2f ms (rolling average of the frames each pass ran)", gpuTotal, cpuTotal);
+    ImGui::Text("total: GPU %.2f ms, CPU %.2f ms (rolling averages)", gpuTotal, cpuTotal);
+    if (!editor.error.empty()) ImGui::TextColored(ImVec4(1, 0.4f, 0.4f, 1), "%s", editor.error.c_str());
+    panelParams(app, editor);
 }
 
 void panelTextures(App& app, DisplaySettings& d) {
@@ -103,6 +206,15 @@ void panelScene(App& app) {
     if (ImGui::Button("step")) app.singleStep = true;
     ImGui::Text("t = %.2f s", app.world().time());
 }
+
+struct WindowState {
+    App* app = nullptr;
+    bool showDebug = true;
+    bool dragging = false;
+    double lastX = 0, lastY = 0;
+    DisplaySettings display;
+    PipelineEditor editor;
+};
 
 GLuint buildDisplayProgram(const ShaderLibrary& shaders) {
     ProgramBuild b = buildProgram(shaders, {{"common/fullscreen.vert", "host/display.frag"}, {}, "kiln.display"});
@@ -215,7 +327,7 @@ int runWindow(const Options& o) {
             ImGui::SetNextWindowSize(ImVec2(420, 520), ImGuiCond_FirstUseEver);
             ImGui::Begin("Kiln (F1)");
             ImGui::Text("%s", app.runtime().pipelineFile().c_str());
-            panelPasses(app);
+            panelPasses(app, state.editor);
             panelTextures(app, state.display);
             panelScene(app);
             ImGui::End();
