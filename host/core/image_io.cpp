@@ -1,5 +1,6 @@
 #include "kiln/image_io.hpp"
 
+#include <stb_image.h>
 #include <stb_image_write.h>
 
 #include <algorithm>
@@ -86,6 +87,24 @@ bool writePfm(const std::string& path, const FloatImage& img, std::string& error
     const bool ok = std::fclose(f) == 0;
     if (!ok) error = path + ": write failed";
     return ok;
+}
+
+bool readPng(const std::string& path, FloatImage& out, std::string& error) {
+    int w = 0, h = 0, n = 0;
+    unsigned char* data = stbi_load(path.c_str(), &w, &h, &n, 4);
+    if (!data) {
+        error = path + ": cannot read PNG: " + (stbi_failure_reason() ? stbi_failure_reason() : "unknown");
+        return false;
+    }
+    out.width = w;
+    out.height = h;
+    out.channels = 4;
+    out.pixels.resize(static_cast<size_t>(w) * h * 4);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w * 4; ++x)
+            out.pixels[static_cast<size_t>(h - 1 - y) * w * 4 + x] = data[static_cast<size_t>(y) * w * 4 + x] / 255.0f;
+    stbi_image_free(data);
+    return true;
 }
 
 }  // namespace kiln

@@ -25,3 +25,8 @@ bool writePng(const std::string& path, const FloatImage& img, int channels, std:
 bool writePfm(const std::string& path, const FloatImage& img, std::string& error);
 
 }  // namespace kiln
+
+namespace kiln {
+// Reads an 8-bit PNG as RGBA floats in [0,1], bottom row first (like readTexture).
+bool readPng(const std::string& path, FloatImage& out, std::string& error);
+}  // namespace kiln
