@@ -85,6 +85,7 @@ std::vector<std::string> checkDeclaration(const PassDeclaration& d) {
     for (const ParamDecl& p : d.params) {
         static constexpr ParamType kTypeOfIndex[] = {ParamType::Bool, ParamType::Int, ParamType::Float,
                                                      ParamType::Enum, ParamType::Color};
+        if (p.def.valueless_by_exception()) continue;
         if (kTypeOfIndex[p.def.index()] != p.type) {
             problems.push_back("parameter " + q(p.name) + " is a " + toString(p.type) + " but its default is a " +
                                toString(kTypeOfIndex[p.def.index()]));
