@@ -15,6 +15,9 @@ struct OrbitCamera {
     glm::vec3 position() const;
     glm::mat4 view() const;
     glm::mat4 projection(float aspect) const;
+    // The world-space ray through a window pixel (origin at the camera, unit direction);
+    // x, y in pixels from the top-left corner, as GLFW reports the cursor.
+    void rayThrough(double x, double y, int width, int height, glm::vec3& origin, glm::vec3& direction) const;
 };
 
 }  // namespace kiln::app

@@ -2,6 +2,7 @@
 #include <catch2/catch.hpp>
 
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
@@ -30,8 +31,11 @@ std::string slurp(const fs::path& p) {
 }
 
 Run runKiln(const std::string& args) {
+    // ctest runs test cases in parallel processes: every run gets its own files.
+    static int serial = 0;
     fs::create_directories(TEST_OUTPUT_DIR);
-    const std::string out = std::string(TEST_OUTPUT_DIR) + "/stdout.txt", err = std::string(TEST_OUTPUT_DIR) + "/stderr.txt";
+    const std::string base = std::string(TEST_OUTPUT_DIR) + "/run-" + std::to_string(getpid()) + "-" + std::to_string(++serial);
+    const std::string out = base + ".out", err = base + ".err";
     const std::string cmd = std::string(KILN_BINARY) + " " + args + " > " + out + " 2> " + err;
     int status = std::system(cmd.c_str());
     return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out), slurp(err)};
@@ -121,6 +125,7 @@ TEST_CASE("kiln --stats prints a row per pass with a GPU time", "[integration][c
 }
 
 TEST_CASE("a bad pipeline exits non-zero with the JSON path on stderr", "[integration][cli]") {
+    fs::create_directories(TEST_OUTPUT_DIR);
     const fs::path file = fs::path(TEST_OUTPUT_DIR) / "bad.json";
     std::ofstream(file) << R"({"output": "composite.color", "passes": [ {"id": "gbuffer", "module": "gbufer"} ]})";
     Run r = runKiln("--headless --size 32x32 --pipeline " + file.string());
