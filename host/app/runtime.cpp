@@ -509,6 +509,15 @@ void Runtime::collectGpuTimes() {
     }
 }
 
+void Runtime::resetTimings() {
+    collectGpuTimes();
+    for (auto& s : slots_) {
+        s->gpuSamples.clear();
+        s->cpuSamples.clear();
+        s->ranFrames = s->skippedFrames = 0;
+    }
+}
+
 const TextureRef* Runtime::outputTexture() const {
     if (!plan_ || !plan_->output.valid()) return nullptr;
     const PassSlot& slot = *slots_[static_cast<size_t>(plan_->output.pass)];

@@ -61,6 +61,8 @@ public:
     // Harvests finished GPU timer queries (renderFrame does it each frame; call after
     // a glFinish to get the last frames' times too).
     void collectGpuTimes();
+    // Forgets every timing sample and ran/skipped count (benchmarks call it after warm-up).
+    void resetTimings();
     // Runs every pass every frame regardless of versions (timing runs).
     bool alwaysRun = false;
 
