@@ -1,0 +1,126 @@
+// The runtime's resource pool and skipping, on the real modules.
+#include <catch2/catch.hpp>
+
+#include <fstream>
+#include <sstream>
+
+#include "app/app.hpp"
+#include "kiln/image_io.hpp"
+#include "support/headless.hpp"
+
+using namespace kiln;
+
+namespace {
+
+struct Fixture {
+    app::App app;
+    Fixture(int size = 48) {
+        REQUIRE(test::ensureHeadlessContext());
+        app::Options o;
+        app::applyDefaults(o);
+        o.headless = true;
+        o.width = o.height = size;
+        o.paused = true;
+        std::string error;
+        REQUIRE(app.init(o, error));
+    }
+    GLuint texture(const char* pass, const char* name) {
+        const TextureRef* t = app.runtime().findTexture(pass, name);
+        return t ? t->id : 0;
+    }
+};
+
+// A minimal two-pass pipeline whose composite exposure is `exposure`.
+std::string pipelineWithExposure(double exposure) {
+    std::ostringstream s;
+    s << R"({"output": "composite.color", "passes": [
+          {"id": "gbuffer", "module": "gbuffer"},
+          {"id": "composite", "module": "composite", "params": {"exposure": )"
+      << exposure << R"(},
+           "inputs": {"albedo": "gbuffer.albedo", "normal": "gbuffer.normal", "depth": "gbuffer.depth"}}]})";
+    return s.str();
+}
+
+}  // namespace
+
+TEST_CASE("recompiling keeps the textures of unchanged passes and renews changed ones", "[runtime][gl]") {
+    Fixture f;
+    std::string errors;
+    REQUIRE(f.app.runtime().loadPipelineText(pipelineWithExposure(1.0), "a.json", errors));
+    f.app.frame();
+    const GLuint albedo = f.texture("gbuffer", "albedo"), color = f.texture("composite", "color");
+    REQUIRE(albedo != 0);
+    REQUIRE(color != 0);
+    REQUIRE(f.app.runtime().loadPipelineText(pipelineWithExposure(2.0), "a.json", errors));
+    CHECK(f.texture("gbuffer", "albedo") == albedo);  // same module, params, inputs
+    CHECK(f.texture("composite", "color") != color);  // its params changed
+}
+
+TEST_CASE("an invalid pipeline keeps the running plan", "[runtime][gl]") {
+    Fixture f;
+    std::string errors;
+    REQUIRE(f.app.runtime().loadPipelineText(pipelineWithExposure(1.0), "a.json", errors));
+    const GLuint color = f.texture("composite", "color");
+    CHECK_FALSE(f.app.runtime().loadPipelineText(pipelineWithExposure(99.0), "a.json", errors));
+    CHECK_THAT(errors, Catch::Contains("passes[1].params.exposure"));
+    CHECK(f.texture("composite", "color") == color);
+    REQUIRE(f.app.runtime().plan());
+    CHECK(f.app.runtime().plan()->passes.size() == 2);
+}
+
+TEST_CASE("resizing reallocates output-relative textures at the new size", "[runtime][gl]") {
+    Fixture f(40);
+    f.app.frame();
+    REQUIRE(f.app.runtime().findTexture("gbuffer", "depth")->width == 40);
+    f.app.resize(64, 32);
+    f.app.frame();
+    const TextureRef* depth = f.app.runtime().findTexture("gbuffer", "depth");
+    CHECK(depth->width == 64);
+    CHECK(depth->height == 32);
+    const TextureRef* out = f.app.displayedTexture();
+    FloatImage img = readTexture(out->id, out->target, out->format, out->width, out->height);
+    CHECK(img.width == 64);
+}
+
+TEST_CASE("a pass whose inputs, parameters and scene did not change is skipped", "[runtime][gl]") {
+    Fixture f;
+    f.app.frame();
+    f.app.frame();
+    for (auto& row : f.app.runtime().stats()) {
+        INFO(row.id);
+        CHECK(row.ranFrames == 1);
+        CHECK(row.skippedFrames == 1);
+        CHECK(row.state == "skipped");
+    }
+    // Moving the camera re-runs the gbuffer, whose new outputs re-run the composite.
+    f.app.camera().yaw += 0.1f;
+    f.app.frame();
+    for (auto& row : f.app.runtime().stats()) {
+        INFO(row.id);
+        CHECK(row.ranFrames == 2);
+    }
+}
+
+TEST_CASE("viewing a culled pass's texture un-culls it without renewing other textures", "[runtime][gl]") {
+    Fixture f;
+    std::string errors;
+    // A second gbuffer nobody reads: culled.
+    std::string text = R"({"output": "composite.color", "passes": [
+          {"id": "gbuffer", "module": "gbuffer"},
+          {"id": "spare", "module": "gbuffer"},
+          {"id": "composite", "module": "composite",
+           "inputs": {"albedo": "gbuffer.albedo", "normal": "gbuffer.normal", "depth": "gbuffer.depth"}}]})";
+    REQUIRE(f.app.runtime().loadPipelineText(text, "c.json", errors));
+    f.app.frame();
+    auto stateOf = [&](const std::string& id) {
+        for (auto& r : f.app.runtime().stats())
+            if (r.id == id) return r.state;
+        return std::string("?");
+    };
+    CHECK(stateOf("spare") == "culled");
+    const GLuint color = f.texture("composite", "color");
+    f.app.runtime().setRequested({"spare.normal"});
+    f.app.frame();
+    CHECK(stateOf("spare") == "ran");
+    CHECK(f.texture("composite", "color") == color);
+}
