@@ -1,0 +1,198 @@
+// kiln/sim/world.hpp — the simulation of Kiln's scene: tumblers rolling on the floor
+// of the Cornell box [-1,1]³, marbles and fireballs bouncing without loss, fire and
+// particles, and mouse picking. Plain data in arrays and a fixed-Δt step; no OpenGL,
+// no hidden globals: same scene, seed and inputs ⇒ bit-identical state (stateHash).
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "kiln/sim/scene.hpp"
+#include "kiln/sim/shape.hpp"
+
+namespace kiln::sim {
+
+// PCG32 (O'Neill): small, fast and identical on every standard library, unlike the
+// std:: distributions.
+class Rng {
+public:
+    explicit Rng(uint64_t seed = 1) { reseed(seed); }
+    void reseed(uint64_t seed);
+    uint32_t next();
+    double uniform() { return next() * (1.0 / 4294967296.0); }               // [0, 1)
+    double uniform(double lo, double hi) { return lo + (hi - lo) * uniform(); }
+    Vec3 inUnitBall();
+    Vec3 onUnitSphere();
+
+private:
+    uint64_t state_ = 0, inc_ = 0;
+};
+
+struct Tumbler {
+    Vec3 position{0.0};     // lower-sphere centre O (the local origin)
+    Quat orientation{1, 0, 0, 0};
+    Vec3 velocity{0.0};     // of O
+    Vec3 angularVelocity{0.0};
+    Vec3 color{1.0};
+    bool asleep = false;
+    double restTime = 0.0;  // seconds below the sleep thresholds
+
+    Mat3 rotation() const { return glm::mat3_cast(orientation); }
+    Vec3 axis() const { return rotation() * Vec3(0, 1, 0); }
+    Vec3 upperCentre(const RoundCone& s) const { return position + rotation() * Vec3(0, s.upperCentre(), 0); }
+    // Column-major 4×4 model matrix (float, ready for a GPU instance buffer).
+    void modelMatrix(float out[16]) const;
+};
+
+enum class BallKind : uint8_t { Marble, Fireball, Burning };
+
+struct Ball {
+    Vec3 position{0.0}, velocity{0.0}, angularVelocity{0.0};
+    double radius = 0.05;
+    BallKind kind = BallKind::Marble;
+    Vec3 color{0.8};
+    double burnTime = 0.0;  // seconds burning (BallKind::Burning)
+    double mass() const { return radius * radius * radius * 8000.0; }  // ∝ volume, glass-ish scale
+};
+
+enum class ParticleKind : uint8_t { Fire, Spark, Ash };
+
+struct Particle {
+    Vec3 position{0.0}, velocity{0.0};
+    double life = 0.0, maxLife = 1.0;  // seconds left / at birth
+    double size = 0.01;                // radius at birth
+    ParticleKind kind = ParticleKind::Fire;
+    // Current radius and emitted colour (SPEC §5: they follow the remaining life).
+    double radius() const;
+    Vec3 emission() const;
+};
+
+struct RayHit {
+    int tumbler = -1;
+    double distance = 0.0;
+    Vec3 point{0.0};
+};
+
+enum class DragMode : uint8_t { Translate, Rotate };
+
+class World {
+public:
+    World() = default;
+    explicit World(const Scene& scene) { reset(scene); }
+
+    // Starts over from `scene` (seed included).
+    void reset(const Scene& scene);
+    void reset() { reset(scene_); }
+    // One fixed frame: `scene.physics.substeps` sub-steps of dt / substeps.
+    void step();
+
+    const Scene& scene() const { return scene_; }
+    const RoundCone& shape() const { return shape_; }
+    const MassProperties& massProperties() const { return mass_; }
+    double time() const { return time_; }
+    uint64_t stepCount() const { return steps_; }
+
+    std::vector<Tumbler>& tumblers() { return tumblers_; }
+    const std::vector<Tumbler>& tumblers() const { return tumblers_; }
+    std::vector<Ball>& balls() { return balls_; }
+    const std::vector<Ball>& balls() const { return balls_; }
+    const std::vector<Particle>& particles() const { return particles_; }
+
+    // Bumped on each step in which a body moved / the particle set changed; a world
+    // whose bodies all sleep (or that is not stepped) keeps them.
+    uint64_t bodiesVersion() const { return bodiesVersion_; }
+    uint64_t particlesVersion() const { return particlesVersion_; }
+
+    void spawnMarble(const Vec3& position, const Vec3& velocity, double radius = 0.05);
+    void spawnFireball(const Vec3& position, const Vec3& velocity, double radius = 0.06);
+    // Spawns at a random free spot with a random velocity (keyboard shortcuts).
+    void spawnRandom(BallKind kind);
+
+    // Signed distance from a world point to tumbler i, and the outward normal there.
+    double tumblerSdf(int i, const Vec3& p) const;
+    Vec3 tumblerNormal(int i, const Vec3& p) const;
+
+    // Sphere-traces the ray against every tumbler; the nearest hit wins.
+    std::optional<RayHit> raycastTumblers(const Vec3& origin, const Vec3& direction) const;
+    // A hit below the centre of mass translates, above rotates (SPEC §4.4).
+    DragMode beginDrag(const RayHit& hit);
+    // Translate: the tumbler follows the ray's intersection with the plane y = s_y.
+    void dragTo(const Vec3& rayOrigin, const Vec3& rayDirection);
+    // Rotate: tilt by (about world x, about world z) radians and roll the matching distance.
+    void dragRotate(double aboutX, double aboutZ);
+    void endDrag();
+    int dragged() const { return drag_.tumbler; }
+
+    // Resolves ball `ball` against tumbler `tumbler` if they overlap: pushes the ball
+    // out and exchanges an elastic impulse (no floor involved). True on contact.
+    bool resolveBallTumblerContact(int ball, int tumbler);
+    // Applies impulse j at world point p to tumbler i (no constraints).
+    void applyImpulse(int i, const Vec3& p, const Vec3& j);
+    // Velocity of the material point of tumbler i at world point p.
+    Vec3 pointVelocity(int i, const Vec3& p) const;
+    // World-space inverse inertia of tumbler i about its centre of mass.
+    Mat3 inverseInertiaWorld(int i) const;
+    Vec3 centreOfMass(int i) const;
+    double tumblerMass() const { return scene_.tumblerShape.mass; }
+
+    // FNV-1a over the raw state (bodies, balls, particles, RNG, time).
+    uint64_t stateHash() const;
+
+    // Diagnostics for tests and `kiln-sim run`.
+    double maxQuaternionError() const;  // max | |q| − 1 |
+    bool allFinite() const;
+    double maxContainmentViolation() const;  // how far any sphere pokes out of the box
+
+private:
+    void substep(double dt);
+    void stepTumbler(int i, double dt);
+    void collideTumblerWalls(int i);
+    void collideTumblerFloor(int i);
+    void collideTumblerPair(int a, int b);
+    void stepBall(Ball& ball, double dt);
+    void collideBallTumblers(int ball);
+    void collideBallPair(int a, int b);
+    void collideBallLamp(Ball& ball);
+    void ignite(int marble, const Vec3& at);
+    void updateParticles(double dt);
+    void emitSparks(const Vec3& at, const Vec3& normal, int count);
+    void emitAsh(const Ball& marble);
+    void wake(int tumbler);
+    Particle* allocateParticle();
+
+    Scene scene_;
+    RoundCone shape_;
+    MassProperties mass_;
+    Vec3 comLocal_{0.0};  // centre of mass in the tumbler's local frame
+    Vec3 inertiaCom_{0.0};
+    std::vector<Tumbler> tumblers_;
+    std::vector<Ball> balls_;
+    std::vector<Particle> particles_;
+    Rng rng_;
+    double time_ = 0.0;
+    uint64_t steps_ = 0;
+    uint64_t bodiesVersion_ = 0, particlesVersion_ = 0;
+    bool bodiesMoved_ = false, particlesChanged_ = false;
+    std::vector<double> fireAccumulator_;  // fractional particles owed per fireball
+
+    struct Drag {
+        int tumbler = -1;
+        DragMode mode = DragMode::Translate;
+        double planeY = 0.0;
+        Vec3 offset{0.0};  // hit point − O at the start of a translate drag
+    } drag_;
+};
+
+// Exact separation of two round cones given by their axis end points and radii
+// (negative when they overlap), with the closest points on their axes.
+struct ConeSeparation {
+    double distance;
+    double s, u;  // parameters on A's and B's axes
+    Vec3 onA, onB;  // axis points
+};
+ConeSeparation roundConeSeparation(const Vec3& a0, const Vec3& a1, double ra0, double ra1, const Vec3& b0,
+                                   const Vec3& b1, double rb0, double rb1);
+
+}  // namespace kiln::sim

@@ -1,0 +1,273 @@
+#include "kiln/sim/scene.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+namespace kiln::sim {
+
+using Json = nlohmann::json;
+
+std::string SceneError::toString(const std::string& file) const {
+    return path.empty() ? file + ": " + message : file + ": " + path + ": " + message;
+}
+
+namespace {
+
+const char* typeName(const Json& j) {
+    switch (j.type()) {
+        case Json::value_t::null: return "null";
+        case Json::value_t::boolean: return "a boolean";
+        case Json::value_t::string: return "a string";
+        case Json::value_t::array: return "an array";
+        case Json::value_t::object: return "an object";
+        case Json::value_t::number_integer:
+        case Json::value_t::number_unsigned:
+        case Json::value_t::number_float: return "a number";
+        default: return "something else";
+    }
+}
+
+// Reads typed values out of one JSON object, remembering its path for messages and
+// which keys were used so unknown ones can be reported.
+struct Reader {
+    const Json& j;
+    std::string path;
+    SceneError& error;
+    std::set<std::string> known;
+
+    std::string at(const std::string& key) const { return path.empty() ? key : path + "." + key; }
+    bool fail(const std::string& where, const std::string& what) {
+        error = {where, what};
+        return false;
+    }
+    bool number(const std::string& key, double& out, double lo, double hi) {
+        known.insert(key);
+        if (!j.contains(key)) return true;
+        const Json& v = j[key];
+        if (!v.is_number()) return fail(at(key), std::string("expected a number, got ") + typeName(v));
+        double d = v.get<double>();
+        if (!std::isfinite(d) || d < lo || d > hi)
+            return fail(at(key), "must be within [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " + v.dump());
+        out = d;
+        return true;
+    }
+    bool integer(const std::string& key, int& out, int lo, int hi) {
+        known.insert(key);
+        if (!j.contains(key)) return true;
+        const Json& v = j[key];
+        if (!v.is_number_integer()) return fail(at(key), std::string("expected an integer, got ") + v.dump());
+        long long n = v.get<long long>();
+        if (n < lo || n > hi)
+            return fail(at(key), "must be within [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " + v.dump());
+        out = int(n);
+        return true;
+    }
+    template <int N>
+    bool vec(const std::string& key, glm::vec<N, double>& out, double lo, double hi) {
+        known.insert(key);
+        if (!j.contains(key)) return true;
+        const Json& v = j[key];
+        if (!v.is_array() || v.size() != N)
+            return fail(at(key), "expected an array of " + std::to_string(N) + " numbers, got " + v.dump());
+        for (int i = 0; i < N; ++i) {
+            if (!v[size_t(i)].is_number())
+                return fail(at(key) + "[" + std::to_string(i) + "]", std::string("expected a number, got ") + typeName(v[size_t(i)]));
+            double d = v[size_t(i)].get<double>();
+            if (!std::isfinite(d) || d < lo || d > hi)
+                return fail(at(key) + "[" + std::to_string(i) + "]",
+                            "must be within [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " + v[size_t(i)].dump());
+            out[i] = d;
+        }
+        return true;
+    }
+    bool choice(const std::string& key, const std::vector<std::string>& choices, int& out) {
+        known.insert(key);
+        if (!j.contains(key)) return true;
+        const Json& v = j[key];
+        std::string list;
+        for (auto& c : choices) list += (list.empty() ? "" : ", ") + ("\"" + c + "\"");
+        if (!v.is_string()) return fail(at(key), "expected one of " + list + ", got " + v.dump());
+        for (size_t i = 0; i < choices.size(); ++i)
+            if (v.get<std::string>() == choices[i]) {
+                out = int(i);
+                return true;
+            }
+        return fail(at(key), "expected one of " + list + ", got " + v.dump());
+    }
+    // Unknown keys are typos until proven otherwise.
+    bool finish() {
+        known.insert("note");
+        for (auto& [k, v] : j.items())
+            if (!known.count(k)) return fail(at(k), "unknown key");
+        return true;
+    }
+};
+
+bool object(const Json& root, const std::string& key, const std::string& path, SceneError& error, const Json*& out) {
+    out = nullptr;
+    if (!root.contains(key)) return true;
+    if (!root[key].is_object()) {
+        error = {path, std::string("expected an object, got ") + typeName(root[key])};
+        return false;
+    }
+    out = &root[key];
+    return true;
+}
+
+bool balls(const Json& root, const std::string& key, std::vector<Scene::BallSpec>& out, double defaultRadius,
+           SceneError& error) {
+    if (!root.contains(key)) return true;
+    if (!root[key].is_array()) {
+        error = {key, std::string("expected an array, got ") + typeName(root[key])};
+        return false;
+    }
+    for (size_t i = 0; i < root[key].size(); ++i) {
+        const Json& b = root[key][i];
+        const std::string path = key + "[" + std::to_string(i) + "]";
+        if (!b.is_object()) {
+            error = {path, std::string("expected an object, got ") + typeName(b)};
+            return false;
+        }
+        Scene::BallSpec spec;
+        spec.radius = defaultRadius;
+        Reader r{b, path, error, {}};
+        if (!r.vec<3>("position", spec.position, -1.0, 1.0) || !r.vec<3>("velocity", spec.velocity, -100.0, 100.0) ||
+            !r.number("radius", spec.radius, 0.005, 0.3) || !r.vec<3>("color", spec.color, 0.0, 100.0) || !r.finish())
+            return false;
+        if (!b.contains("position")) {
+            error = {path + ".position", "missing (a ball needs a position)"};
+            return false;
+        }
+        for (int a = 0; a < 3; ++a)
+            if (std::abs(spec.position[a]) > 1.0 - spec.radius) {
+                error = {path + ".position", "the ball (radius " + b.value("radius", Json(spec.radius)).dump() +
+                                                 ") does not fit inside the box [-1,1]^3"};
+                return false;
+            }
+        out.push_back(spec);
+    }
+    return true;
+}
+
+}  // namespace
+
+bool parseScene(const std::string& text, Scene& out, SceneError& error) {
+    Json root;
+    try {
+        root = Json::parse(text);
+    } catch (const Json::parse_error& e) {
+        // Byte offset → line and column.
+        size_t offset = std::min<size_t>(e.byte > 0 ? e.byte - 1 : 0, text.size());
+        int line = 1, column = 1;
+        for (size_t i = 0; i < offset; ++i) {
+            if (text[i] == '\n') ++line, column = 1;
+            else ++column;
+        }
+        std::string what = e.what();
+        auto colon = what.rfind(": ");
+        error = {"", "line " + std::to_string(line) + ", column " + std::to_string(column) + ": " +
+                         (colon == std::string::npos ? what : what.substr(colon + 2))};
+        return false;
+    }
+    if (!root.is_object()) {
+        error = {"", std::string("the scene must be a JSON object, got ") + typeName(root)};
+        return false;
+    }
+    Scene s;
+    const Json* o = nullptr;
+    if (!object(root, "box", "box", error, o)) return false;
+    if (o) {
+        Reader r{*o, "box", error, {}};
+        if (!r.vec<3>("left", s.box.left, 0, 1) || !r.vec<3>("right", s.box.right, 0, 1) ||
+            !r.vec<3>("other", s.box.other, 0, 1) || !r.finish())
+            return false;
+    }
+    if (!object(root, "lamp", "lamp", error, o)) return false;
+    if (o) {
+        Reader r{*o, "lamp", error, {}};
+        if (!r.vec<3>("center", s.lamp.center, -2, 3) || !r.number("radius", s.lamp.radius, 0.01, 0.9) ||
+            !r.vec<3>("color", s.lamp.color, 0, 1) || !r.number("intensity", s.lamp.intensity, 0, 1e4) || !r.finish())
+            return false;
+    }
+    if (!object(root, "physics", "physics", error, o)) return false;
+    if (o) {
+        Reader r{*o, "physics", error, {}};
+        int mode = int(s.physics.tumblerMode), contact = int(s.physics.tumblerContact);
+        double seed = double(s.physics.seed);
+        if (!r.number("dt", s.physics.dt, 1e-5, 0.1) || !r.integer("substeps", s.physics.substeps, 1, 64) ||
+            !r.number("gravity", s.physics.gravity, 0, 100) || !r.number("friction", s.physics.friction, 0, 10) ||
+            !r.number("wall_decay", s.physics.wallDecay, 0, 1) ||
+            !r.choice("tumbler_mode", {"seed", "accurate"}, mode) ||
+            !r.choice("tumbler_contact", {"four_spheres", "exact"}, contact) ||
+            !r.number("ballast_h", s.physics.ballastH, -0.19, 0.19) || !r.number("seed", seed, 0, 4294967295.0) || !r.finish())
+            return false;
+        s.physics.tumblerMode = TumblerMode(mode);
+        s.physics.tumblerContact = TumblerContact(contact);
+        s.physics.seed = uint64_t(seed);
+    }
+    if (!object(root, "tumbler_shape", "tumbler_shape", error, o)) return false;
+    if (o) {
+        Reader r{*o, "tumbler_shape", error, {}};
+        double alphaDeg = s.tumblerShape.alpha * 180.0 / 3.14159265358979323846;
+        if (!r.number("b", s.tumblerShape.b, 0.02, 0.4) || !r.number("t", s.tumblerShape.t, 0.01, 0.4) ||
+            !r.number("alpha_deg", alphaDeg, 1, 80) || !r.number("mass", s.tumblerShape.mass, 1e-3, 1e3) || !r.finish())
+            return false;
+        if (s.tumblerShape.t >= s.tumblerShape.b) {
+            error = {"tumbler_shape.t", "must be smaller than b (the upper sphere sits on the lower one)"};
+            return false;
+        }
+        s.tumblerShape.alpha = alphaDeg * 3.14159265358979323846 / 180.0;
+    }
+    if (!root.contains("tumblers") || !root["tumblers"].is_array()) {
+        error = {"tumblers", root.contains("tumblers") ? std::string("expected an array, got ") + typeName(root["tumblers"])
+                                                       : "missing (the list of tumblers, possibly empty)"};
+        return false;
+    }
+    const double b = s.tumblerShape.b;
+    for (size_t i = 0; i < root["tumblers"].size(); ++i) {
+        const Json& t = root["tumblers"][i];
+        const std::string path = "tumblers[" + std::to_string(i) + "]";
+        if (!t.is_object()) {
+            error = {path, std::string("expected an object, got ") + typeName(t)};
+            return false;
+        }
+        Scene::TumblerSpec spec;
+        Reader r{t, path, error, {}};
+        if (!r.vec<2>("position", spec.position, -1, 1) || !r.vec<2>("tilt", spec.tilt, -1.5, 1.5) ||
+            !r.vec<3>("color", spec.color, 0, 1) || !r.finish())
+            return false;
+        if (std::abs(spec.position.x) > 1.0 - b || std::abs(spec.position.y) > 1.0 - b) {
+            error = {path + ".position", "a tumbler of radius " + std::to_string(b) + " at this spot pokes out of the box"};
+            return false;
+        }
+        s.tumblers.push_back(spec);
+    }
+    if (!balls(root, "marbles", s.marbles, 0.05, error) || !balls(root, "fireballs", s.fireballs, 0.06, error))
+        return false;
+    Reader top{root, "", error, {"box", "lamp", "physics", "tumbler_shape", "tumblers", "marbles", "fireballs", "$schema"}};
+    if (!top.finish()) return false;
+    out = std::move(s);
+    return true;
+}
+
+bool loadScene(const std::string& path, Scene& out, std::string& error) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) {
+        error = path + ": cannot read scene file";
+        return false;
+    }
+    std::stringstream ss;
+    ss << in.rdbuf();
+    SceneError e;
+    if (!parseScene(ss.str(), out, e)) {
+        error = e.toString(path);
+        return false;
+    }
+    return true;
+}
+
+}  // namespace kiln::sim
