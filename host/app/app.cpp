@@ -72,7 +72,7 @@ void App::frame() {
     }
     SceneView view = buildView();
     static_assert(sizeof(view.versions) == 6 * sizeof(uint64_t));
-    world_.sync(runtime_.scene(), sceneVersions_);
+    world_.sync(runtime_.scene(), sceneVersions_, world_.sim().dragged());
     if (view.frame.viewProj != lastViewProj_) {
         lastViewProj_ = view.frame.viewProj;
         ++sceneVersions_[sceneCategoryIndex(kSceneCamera)];

@@ -31,9 +31,13 @@ usage: kiln [options]
   --modules DIR     pass module directory (default: the build's modules/)
   --help            this text
 
-Window keys:
-  mouse drag (empty space)  orbit the camera      wheel  zoom
-  F1  toggle the debug view     Esc  quit
+Window keys and mouse:
+  drag a tumbler below its centre   move it on the floor
+  drag a tumbler above its centre   tilt it (it rolls the matching distance)
+  drag empty space                  orbit the camera          wheel  zoom
+  Space  pause/resume   .  single step   R  reset the scene
+  M  spawn a marble     F  spawn a fireball
+  F1  toggle the debug view              Esc  quit
 )";
 
 namespace {

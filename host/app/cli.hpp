@@ -7,6 +7,8 @@
 
 namespace kiln::app {
 
+inline constexpr uint64_t kSceneSeed = ~0ull;
+
 struct Options {
     std::string pipeline;     // default: <source>/pipelines/default.json
     std::string scene;        // default: <source>/scenes/cornell.json
@@ -21,7 +23,7 @@ struct Options {
     bool noSkip = false;      // run every pass every frame (for timing tables)
     bool printPlan = false;
     std::string dot;          // write the plan as graphviz
-    uint64_t seed = 1;
+    uint64_t seed = kSceneSeed;  // kSceneSeed: the scene file's physics.seed
     bool paused = false;      // freeze the simulation (time stays at 0 + frames×0)
     bool help = false;
     std::string screenshot;   // window: save the window after --frames frames and quit

@@ -201,16 +201,25 @@ void panelErrors(App& app) {
 
 void panelScene(App& app) {
     if (!ImGui::CollapsingHeader("Scene", ImGuiTreeNodeFlags_DefaultOpen)) return;
-    ImGui::Checkbox("paused", &app.paused);
+    auto& sim = app.world().sim();
+    ImGui::Checkbox("paused (Space)", &app.paused);
     ImGui::SameLine();
-    if (ImGui::Button("step")) app.singleStep = true;
-    ImGui::Text("t = %.2f s", app.world().time());
+    if (ImGui::Button("step (.)")) app.singleStep = true;
+    ImGui::SameLine();
+    if (ImGui::Button("reset (R)")) app.world().reset();
+    if (ImGui::Button("spawn marble (M)")) sim.spawnRandom(sim::BallKind::Marble);
+    ImGui::SameLine();
+    if (ImGui::Button("spawn fireball (F)")) sim.spawnRandom(sim::BallKind::Fireball);
+    ImGui::Text("t = %.2f s, %zu balls, %zu particles", app.world().time(), sim.balls().size(), sim.particles().size());
+    ImGui::TextUnformatted("drag a tumbler: low to move it, high to tilt it");
 }
 
 struct WindowState {
     App* app = nullptr;
     bool showDebug = true;
     bool dragging = false;
+    bool draggingTumbler = false;
+    sim::DragMode dragMode = sim::DragMode::Translate;
     double lastX = 0, lastY = 0;
     DisplaySettings display;
     PipelineEditor editor;
@@ -283,6 +292,9 @@ int runWindow(const Options& o) {
         if (key == GLFW_KEY_F1) s->showDebug = !s->showDebug;
         if (key == GLFW_KEY_SPACE) s->app->paused = !s->app->paused;
         if (key == GLFW_KEY_PERIOD) s->app->singleStep = true;
+        if (key == GLFW_KEY_M) s->app->world().sim().spawnRandom(sim::BallKind::Marble);
+        if (key == GLFW_KEY_F) s->app->world().sim().spawnRandom(sim::BallKind::Fireball);
+        if (key == GLFW_KEY_R) s->app->world().reset();
     });
     // Ours first: ImGui's GLFW backend chains to the callbacks it finds installed.
     IMGUI_CHECKVERSION();
@@ -298,18 +310,36 @@ int runWindow(const Options& o) {
     int frames = 0;
     while (!glfwWindowShouldClose(window)) {
         glfwPollEvents();
-        // Orbit with the left mouse button on empty space.
+        // Left button: on a tumbler it drags it (SPEC §4.4: below the centre of mass
+        // translates, above rotates); on empty space it orbits the camera.
         double x, y;
         glfwGetCursorPos(window, &x, &y);
+        int winW, winH;
+        glfwGetWindowSize(window, &winW, &winH);
         const bool down = glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS;
+        auto& sim = app.world().sim();
         if (down && !ImGui::GetIO().WantCaptureMouse) {
-            if (state.dragging) {
+            glm::vec3 origin, dir;
+            app.camera().rayThrough(x, y, winW, winH, origin, dir);
+            if (!state.dragging) {
+                state.dragging = true;
+                state.draggingTumbler = false;
+                if (auto hit = sim.raycastTumblers(sim::Vec3(origin), sim::Vec3(dir))) {
+                    state.dragMode = sim.beginDrag(*hit);
+                    state.draggingTumbler = true;
+                }
+            } else if (state.draggingTumbler) {
+                if (state.dragMode == sim::DragMode::Translate)
+                    sim.dragTo(sim::Vec3(origin), sim::Vec3(dir));
+                else  // screen drag right tilts about −z (rolls right), drag down tilts about +x
+                    sim.dragRotate((y - state.lastY) * 0.01, -(x - state.lastX) * 0.01);
+            } else {
                 app.camera().yaw -= float(x - state.lastX) * 0.005f;
                 app.camera().pitch = std::clamp(app.camera().pitch + float(y - state.lastY) * 0.005f, -1.2f, 1.2f);
             }
-            state.dragging = true;
-        } else {
-            state.dragging = false;
+        } else if (state.dragging) {
+            if (state.draggingTumbler) sim.endDrag();
+            state.dragging = state.draggingTumbler = false;
         }
         state.lastX = x, state.lastY = y;
 
