@@ -79,7 +79,10 @@ void App::frame() {
     }
     if (!paused) ++sceneVersions_[sceneCategoryIndex(kSceneTime)];
     std::copy(std::begin(sceneVersions_), std::end(sceneVersions_), view.versions);
-    for (uint32_t bit = 0; bit < 6; ++bit) view.counts[bit] = runtime_.scene().count(DrawCategory(1u << bit));
+    for (uint32_t bit = 0; bit < 6; ++bit) {
+        view.counts[bit] = runtime_.scene().count(DrawCategory(1u << bit));
+        view.drawVersions[bit] = runtime_.scene().version(DrawCategory(1u << bit));
+    }
 
     FrameInfo info;
     info.index = frameIndex_++;

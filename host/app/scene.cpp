@@ -61,7 +61,17 @@ void SceneRenderer::setBox(const BoxLook& box) {
     wall(glm::rotate(glm::translate(I, {0, 0, -1}), glm::radians(90.0f), {1, 0, 0}), box.other, 0.0f);           // back
     // The lamp dome: its mesh is already in world space.
     staticInstances_.push_back({I, glm::vec4(box.lampColor, 0.0f), glm::vec4(box.lampColor * box.lampIntensity, 0.0f)});
+    noteContents(kDrawBox, staticInstances_.data(), 5);
+    noteContents(kDrawLamp, staticInstances_.data() + 5, 1);
     dirty_ = true;
+}
+
+void SceneRenderer::noteContents(DrawCategory c, const GpuInstance* begin, size_t count) {
+    uint64_t h = 1469598103934665603ull ^ count;
+    const auto* bytes = reinterpret_cast<const unsigned char*>(begin);
+    for (size_t i = 0; i < count * sizeof(GpuInstance); ++i) h = (h ^ bytes[i]) * 1099511628211ull;
+    const int k = drawCategoryIndex(c);
+    if (h != hashes_[k]) hashes_[k] = h, ++versions_[k];
 }
 
 void SceneRenderer::setBodies(const std::vector<BodyInstance>& bodies) {
@@ -72,6 +82,15 @@ void SceneRenderer::setBodies(const std::vector<BodyInstance>& bodies) {
     bodyInstances_.clear();
     for (auto& b : bodies_)
         bodyInstances_.push_back({b.model, glm::vec4(b.albedo, 0.0f), glm::vec4(b.emissive, b.highlighted ? 1.0f : 0.0f)});
+    for (DrawCategory c : {kDrawTumblers, kDrawMarbles, kDrawFireballs}) {
+        size_t first = 0, n = 0;
+        for (size_t i = 0; i < bodies_.size(); ++i)
+            if (bodies_[i].category == c) {
+                if (n == 0) first = i;
+                ++n;
+            }
+        noteContents(c, bodyInstances_.data() + first, n);
+    }
     dirty_ = true;
 }
 
@@ -81,6 +100,7 @@ void SceneRenderer::setParticles(const std::vector<ParticleInstance>& particles)
         glm::mat4 m = glm::scale(glm::translate(glm::mat4(1.0f), p.position), glm::vec3(p.radius));
         particleInstances_.push_back({m, glm::vec4(0.0f), glm::vec4(p.emissive, 0.0f)});
     }
+    noteContents(kDrawParticles, particleInstances_.data(), particleInstances_.size());
     dirty_ = true;
 }
 
@@ -127,9 +147,14 @@ void SceneRenderer::upload() {
 }
 
 uint32_t SceneRenderer::count(DrawCategory c) const {
-    for (auto& g : groups_)
-        if (g.category == c) return g.count;
-    return 0;
+    switch (c) {
+        case kDrawBox: return 5;
+        case kDrawLamp: return 1;
+        case kDrawParticles: return static_cast<uint32_t>(particleInstances_.size());
+        default:
+            return static_cast<uint32_t>(
+                std::count_if(bodies_.begin(), bodies_.end(), [&](const BodyInstance& b) { return b.category == c; }));
+    }
 }
 
 void SceneRenderer::draw(const DrawFilter& filter) const {

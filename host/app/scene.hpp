@@ -55,6 +55,8 @@ public:
     // Instanced draws of every group matching the filter with the current program.
     void draw(const DrawFilter&) const;
     uint32_t count(DrawCategory c) const;
+    // Bumped whenever a category's instance data changed (content hash).
+    uint64_t version(DrawCategory c) const { return versions_[drawCategoryIndex(c)]; }
     const BoxLook& box() const { return box_; }
 
 private:
@@ -74,6 +76,9 @@ private:
     std::vector<BodyInstance> bodies_;
     std::vector<Group> groups_;
     bool dirty_ = true;
+    uint64_t versions_[6] = {};
+    uint64_t hashes_[6] = {};
+    void noteContents(DrawCategory, const GpuInstance* begin, size_t count);
 };
 
 }  // namespace kiln::app

@@ -22,6 +22,8 @@ public:
             .param(floatParam("ambient", 0.03f, 0.0, 1.0, "constant fill light when no indirect input is bound"))
             .param(enumParam("tonemap", "aces", {"aces", "reinhard", "clamp"}))
             .param(floatParam("gamma", 2.2f, 1.0, 3.0))
+            .param(intChoiceParam("pcf", 5, {1, 3, 5, 7, 9}, "shadow filter kernel side: 5 = the seed's 5x5, 1 = hard"))
+            .param(floatParam("shadow_bias", 0.0005f, 0.0, 0.05, "depth bias of the shadow test"))
             .shader("composite/composite.frag");
         d.reads = kSceneLight | kSceneCamera;
         return d;
@@ -39,6 +41,8 @@ public:
         glUniform1f(glGetUniformLocation(program, "u_ambient"), ctx.getFloat("ambient"));
         glUniform1f(glGetUniformLocation(program, "u_gamma"), ctx.getFloat("gamma"));
         glUniform1i(glGetUniformLocation(program, "u_tonemap"), tonemap == "aces" ? 0 : tonemap == "reinhard" ? 1 : 2);
+        glUniform1i(glGetUniformLocation(program, "u_pcf"), ctx.getInt("pcf"));
+        glUniform1f(glGetUniformLocation(program, "u_shadowBias"), ctx.getFloat("shadow_bias"));
         ctx.drawFullscreenTriangle();
     }
 };

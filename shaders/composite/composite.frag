@@ -3,6 +3,7 @@
 // with the seed's "directional" attenuation by the angle between the light direction
 // and +y (the hemisphere lamp shades the wall tops), plus emission, indirect, bloom.
 #include "common/frame.glsl"
+#include "common/light.glsl"
 
 in vec2 v_uv;
 layout(location = 0) out vec4 o_color;
@@ -20,6 +21,26 @@ uniform float u_exposure;
 uniform float u_ambient;
 uniform float u_gamma;
 uniform int u_tonemap;
+uniform int u_pcf;
+uniform float u_shadowBias;
+
+// Fraction of the lamp that sees p: a k×k percentage-closer filter over the shadow
+// map (k = u_pcf; 1 is a hard shadow). No map bound: everything is lit.
+float lightVisibility(vec3 p) {
+#if KILN_HAS_SHADOW_MAP
+    vec4 ls = lightSpace(p);
+    if (ls.w == 0.0) return 1.0;
+    vec2 texel = 1.0 / vec2(textureSize(u_shadowMap, 0));
+    int r = u_pcf / 2;
+    float lit = 0.0;
+    for (int y = -r; y <= r; ++y)
+        for (int x = -r; x <= r; ++x)
+            lit += (ls.z - u_shadowBias <= texture(u_shadowMap, ls.xy + vec2(x, y) * texel).r) ? 1.0 : 0.0;
+    return lit / float((2 * r + 1) * (2 * r + 1));
+#else
+    return 1.0;
+#endif
+}
 
 vec3 worldPosition(vec2 uv, float depth) {
     vec4 p = u_invViewProj * vec4(uv * 2.0 - 1.0, depth * 2.0 - 1.0, 1.0);
@@ -48,7 +69,8 @@ void main() {
         // The lamp is a hemisphere opening downwards: light leaving it at a grazing
         // angle to −y is dimmer. cos of the angle between −l and −y, shaped.
         float directional = smoothstep(0.0, 1.0, clamp(dot(-l, vec3(0, -1, 0)), 0.0, 1.0));
-        vec3 direct = albedo / 3.14159265 * u_lightColor.rgb * cosTheta * directional;
+        float visible = cosTheta > 0.0 ? lightVisibility(p + n * 0.004) : 0.0;
+        vec3 direct = albedo / 3.14159265 * u_lightColor.rgb * cosTheta * directional * visible;
         vec3 indirect = albedo * texture(u_indirect, v_uv).rgb;
 #if KILN_HAS_INDIRECT == 0
         indirect = albedo * u_ambient;

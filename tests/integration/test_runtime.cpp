@@ -92,12 +92,13 @@ TEST_CASE("a pass whose inputs, parameters and scene did not change is skipped",
         CHECK(row.skippedFrames == 1);
         CHECK(row.state == "skipped");
     }
-    // Moving the camera re-runs the gbuffer, whose new outputs re-run the composite.
+    // Moving the camera re-runs the gbuffer, whose new outputs re-run the composite;
+    // the shadow map does not depend on the camera and stays as it is.
     f.app.camera().yaw += 0.1f;
     f.app.frame();
     for (auto& row : f.app.runtime().stats()) {
         INFO(row.id);
-        CHECK(row.ranFrames == 2);
+        CHECK(row.ranFrames == (row.id == "shadow" ? 1 : 2));
     }
 }
 

@@ -3,7 +3,7 @@
 // The final image (gamma-encoded RGBA8) is decoded to linear (power 2.2, the
 // composite pass's default gamma) and compared with the committed golden PNG by RMSE
 // over RGB. To regenerate after an intended change:
-//     KILN_UPDATE_GOLDENS=1 ctest -R golden      (then review and commit tests/goldens/)
+//     KILN_UPDATE_GOLDENS=1 ./build/bin/test_integration "[golden]"   (review, commit tests/goldens/)
 #pragma once
 
 #include <catch2/catch.hpp>

@@ -52,6 +52,9 @@ struct GpuFrame {
 inline constexpr unsigned kFrameBinding = 0;      // uniform block
 inline constexpr unsigned kInstanceBinding = 0;   // shader storage block
 
+int sceneCategoryIndex(SceneCategory);
+int drawCategoryIndex(DrawCategory);
+
 struct SceneView {
     GpuFrame frame{};
     glm::vec3 cameraPos{0.0f};
@@ -63,13 +66,15 @@ struct SceneView {
     // changed. Index with sceneCategoryIndex().
     uint64_t versions[6] = {};
     uint32_t counts[6] = {};  // instances per DrawCategory bit index
+    // Bumped when that DrawCategory's instances changed (finer than kSceneBodies: the
+    // shadow map cares whether a caster moved, not whether a fireball did).
+    uint64_t drawVersions[6] = {};
 
     uint64_t version(SceneCategory c) const;
     uint32_t count(DrawCategory c) const;
+    uint64_t drawVersion(DrawCategory c) const { return drawVersions[drawCategoryIndex(c)]; }
 };
 
-int sceneCategoryIndex(SceneCategory);
-int drawCategoryIndex(DrawCategory);
 
 inline uint64_t SceneView::version(SceneCategory c) const { return versions[sceneCategoryIndex(c)]; }
 inline uint32_t SceneView::count(DrawCategory c) const { return counts[drawCategoryIndex(c)]; }
