@@ -45,8 +45,9 @@ Scene convergenceScene(double dt) {
     s.physics.dt = dt;
     s.physics.substeps = 1;
     s.physics.friction = 0.0;
-    s.tumblers.push_back({{0.4, 0.0}, {0.0, 0.3}, {1, 0, 0}});
-    s.marbles.push_back({{-0.5, 0.5, 0.2}, {0.7, 0.0, -0.4}, 0.05, {1, 1, 1}});
+    // Far apart, so the marble's wall and floor bounces are the only events.
+    s.tumblers.push_back({{-0.5, -0.6}, {0.0, 0.3}, {1, 0, 0}});
+    s.marbles.push_back({{0.3, 0.5, 0.5}, {0.5, 0.0, 0.3}, 0.05, {1, 1, 1}});
     return s;
 }
 
@@ -118,14 +119,21 @@ int main(int argc, char** argv) {
         csv << "dt,marble_error_m,tumbler_error_m\n";
         const double dts[] = {1.0 / 60, 1.0 / 120, 1.0 / 240, 1.0 / 480};
         const double fine = dts[3] / 64.0;
+        // The marble is compared at t = 0.3 s, before its first floor bounce: a bounce
+        // shifts its phase by up to one step, which swamps the integrator's error at a
+        // fixed later time. The rocking tumbler is compared at t = 2 s.
         auto run = [](double dt) {
             World w(convergenceScene(dt));
-            const int n = int(std::lround(2.0 / dt));
-            for (int i = 0; i < n; ++i) w.step();
-            return std::make_pair(w.balls()[0].position, w.tumblers()[0].upperCentre(w.shape()));
+            Vec3 marble(0.0);
+            const int n = int(std::lround(2.0 / dt)), marbleStep = int(std::lround(0.3 / dt));
+            for (int i = 0; i < n; ++i) {
+                w.step();
+                if (i + 1 == marbleStep) marble = w.balls()[0].position;
+            }
+            return std::make_pair(marble, w.tumblers()[0].upperCentre(w.shape()));
         };
         auto ref = run(fine);
-        std::printf("\nposition error at t = 2 s vs a dt = %.2e run\n  %10s %14s %8s %14s %8s\n", fine, "dt", "marble m",
+        std::printf("\nposition error (marble at t = 0.3 s, tumbler top at t = 2 s) vs a dt = %.2e run\n  %10s %14s %8s %14s %8s\n", fine, "dt", "marble m",
                     "order", "tumbler m", "order");
         double prevM = 0, prevT = 0;
         for (double dt : dts) {
