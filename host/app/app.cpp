@@ -12,7 +12,13 @@ bool App::init(const Options& o, std::string& error) {
     viewed = o.view;
     RuntimeOptions ro;
     ro.shaderRoots = {o.shaderRoot};
-    ro.moduleDirs = {o.moduleDir};
+    // --modules may list several directories, separated by ':'.
+    for (size_t start = 0; start <= o.moduleDir.size();) {
+        size_t end = o.moduleDir.find(':', start);
+        if (end == std::string::npos) end = o.moduleDir.size();
+        if (end > start) ro.moduleDirs.emplace_back(o.moduleDir.substr(start, end - start));
+        start = end + 1;
+    }
     ro.width = o.width;
     ro.height = o.height;
     if (!runtime_.init(ro, error)) return false;
@@ -25,6 +31,7 @@ bool App::init(const Options& o, std::string& error) {
         error = errors;
         return false;
     }
+    if (o.live) live_.start(*this);
     if (o.printPlan) std::printf("%s", runtime_.plan()->table().c_str());
     if (!o.dot.empty()) {
         std::FILE* f = std::fopen(o.dot.c_str(), "w");
@@ -66,6 +73,7 @@ SceneView App::buildView() const {
 }
 
 void App::frame() {
+    live_.poll(*this);  // edits land at a frame boundary, on this thread
     if (!paused || singleStep) {
         world_.step();
         singleStep = false;

@@ -7,6 +7,7 @@
 
 #include "app/camera.hpp"
 #include "app/cli.hpp"
+#include "app/live.hpp"
 #include "app/runtime.hpp"
 #include "app/world.hpp"
 
@@ -25,6 +26,8 @@ public:
     Runtime& runtime() { return runtime_; }
     World& world() { return world_; }
     OrbitCamera& camera() { return camera_; }
+    LiveReload& live() { return live_; }
+    uint64_t seed() const { return options_.seed; }
     bool paused = false;
     bool singleStep = false;
     std::string viewed;  // "pass.output" or empty for the graph output
@@ -36,6 +39,7 @@ private:
     Runtime runtime_;
     World world_;
     OrbitCamera camera_;
+    LiveReload live_;
     uint64_t frameIndex_ = 0;
     glm::mat4 lastViewProj_{0.0f};
     uint64_t sceneVersions_[6] = {};

@@ -19,6 +19,7 @@ usage: kiln [options]
   --out FILE.png    write the final image (headless)
   --dump DIR        write every texture of the last frame (PNG, and PFM for float/depth)
   --stats           print the per-pass time table (GPU timer queries + CPU clock)
+  --no-live         do not watch files for live reloading
   --no-skip         run every pass every frame, even when nothing it reads changed
   --plan            print the compiled plan (order, culled passes and why)
   --dot FILE        write the plan as graphviz dot
@@ -28,7 +29,7 @@ usage: kiln [options]
   --seed N          simulation seed (same seed, same frames)
   --paused          do not advance the simulation
   --shaders DIR     shader root (default shaders/)
-  --modules DIR     pass module directory (default: the build's modules/)
+  --modules DIRS    pass module directories, ':'-separated (default: the build's modules/)
   --help            this text
 
 Window keys and mouse:
@@ -72,6 +73,8 @@ std::optional<Options> parseOptions(int argc, char** argv, std::string& error) {
             o.headless = true;
         } else if (a == "--stats") {
             o.stats = true;
+        } else if (a == "--no-live") {
+            o.live = false;
         } else if (a == "--no-skip") {
             o.noSkip = true;
         } else if (a == "--plan") {

@@ -24,6 +24,7 @@ struct Options {
     bool printPlan = false;
     std::string dot;          // write the plan as graphviz
     uint64_t seed = kSceneSeed;  // kSceneSeed: the scene file's physics.seed
+    bool live = true;         // watch files and reload them while running
     bool paused = false;      // freeze the simulation (time stays at 0 + frames×0)
     bool help = false;
     std::string screenshot;   // window: save the window after --frames frames and quit

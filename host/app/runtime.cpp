@@ -103,7 +103,9 @@ public:
             if (desc.debugName.empty()) desc.debugName = slot_.id + ":" + desc.stages.back();
             ProgramBuild build = buildProgram(*rt_.shaders_, desc);
             ProgramEntry entry;
+            entry.desc = desc;
             entry.dependencies = build.dependencies;
+            ++slot_.programGeneration;
             if (build.ok()) {
                 entry.program = std::move(build.program);
             } else {
@@ -338,6 +340,7 @@ void Runtime::adoptPlan(graph::Plan plan) {
             slot->library = info.library;
             slot->pass = ModuleLoader::create(info.library, error);
             if (!slot->pass) slot->error = error;
+            slot->lastRunKey.reset();
         }
         next.push_back(std::move(slot));
     }
@@ -415,7 +418,7 @@ std::vector<uint64_t> Runtime::runKey(const graph::PlannedPass& planned, const P
     for (int i = 0; i < 6; ++i)
         key.push_back((planned.decl.reads & (1u << i)) ? view.versions[i] : 0);
     key.push_back(static_cast<uint64_t>(options_.width) << 32 | static_cast<uint32_t>(options_.height));
-    key.push_back(slot.programs.size());  // a newly (re)built program runs the pass again
+    key.push_back(slot.programGeneration);  // a newly (re)built program runs the pass again
     return key;
 }
 
@@ -587,9 +590,84 @@ std::vector<Runtime::TextureInfo> Runtime::textures() const {
 
 std::vector<std::string> Runtime::activeErrors() const {
     std::vector<std::string> errors;
-    for (auto& s : slots_)
+    for (auto& [key, message] : externalErrors_) errors.push_back(message);
+    for (auto& s : slots_) {
         if (!s->error.empty()) errors.push_back(s->id + ": " + s->error);
+        for (auto& [key, entry] : s->programs)
+            if (!entry.error.empty() && entry.program)  // broken edit, last good program running
+                errors.push_back(s->id + ": " + entry.error);
+    }
     return errors;
+}
+
+void Runtime::setExternalError(const std::string& key, const std::string& message) {
+    if (message.empty()) externalErrors_.erase(key);
+    else externalErrors_[key] = message;
+}
+
+int Runtime::reloadShaders(const std::vector<fs::path>& changed) {
+    int rebuilt = 0;
+    for (auto& slot : slots_) {
+        for (auto& [key, entry] : slot->programs) {
+            bool affected = false;
+            for (auto& dep : entry.dependencies)
+                for (auto& c : changed) affected |= dep == c;
+            if (!affected) continue;
+            // Built aside; swapped in only if it compiles and links.
+            ProgramBuild build = buildProgram(*shaders_, entry.desc);
+            if (!build.dependencies.empty()) entry.dependencies = build.dependencies;
+            if (build.ok()) {
+                entry.program = std::move(build.program);
+                entry.error.clear();
+                slot->error.clear();
+                ++slot->programGeneration;
+                ++rebuilt;
+            } else {
+                entry.error = build.errorText();
+                if (!entry.error.empty() && entry.error.back() == '\n') entry.error.pop_back();
+                log::error(entry.error);
+            }
+        }
+    }
+    return rebuilt;
+}
+
+bool Runtime::reloadModule(const std::string& name, std::string& error) {
+    auto library = loader_->load(name, error);
+    if (!library) return false;
+    PassPtr probe = ModuleLoader::create(library, error);
+    if (!probe) return false;
+    PassDeclaration decl;
+    try {
+        decl = probe->declare();
+    } catch (const std::exception& e) {
+        error = library->sourcePath().string() + ": declare() threw: " + e.what();
+        return false;
+    }
+    probe.reset();
+    // Validate the pipeline against the new declaration before touching anything.
+    auto old = modules_.find(name) != modules_.end() ? std::optional<ModuleInfo>(modules_[name]) : std::nullopt;
+    modules_[name] = {library, decl};
+    std::string errors;
+    if (!pipelineText_.empty() && !loadPipelineText(pipelineText_, pipelineFile_, errors)) {
+        if (old) modules_[name] = *old;
+        else modules_.erase(name);
+        error = errors;
+        return false;
+    }
+    old.reset();
+    // Objects of the old library go first (their code lives there); their slots keep
+    // textures and parameters, and get an object of the new library.
+    for (size_t i = 0; i < slots_.size(); ++i) {
+        auto& slot = *slots_[i];
+        if (slot.module != name || plan_->passes[i].state == graph::PassState::Disabled) continue;
+        slot.pass.reset();
+        slot.library = library;
+        slot.pass = ModuleLoader::create(library, error);
+        if (!slot.pass) slot.error = error;
+        slot.lastRunKey.reset();
+    }
+    return true;
 }
 
 bool Runtime::dump(const fs::path& dir, std::string& error) const {

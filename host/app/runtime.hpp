@@ -82,6 +82,17 @@ public:
     // slice of level 0.
     bool dump(const std::filesystem::path& dir, std::string& error) const;
 
+    // Live reload. Rebuilds every program that read one of `changedFiles` (absolute
+    // paths); a failed build keeps the last good program and reports the mapped
+    // error. Returns how many programs were rebuilt successfully.
+    int reloadShaders(const std::vector<std::filesystem::path>& changedFiles);
+    // Loads a fresh copy of module `name`; on success every pass of that module gets a
+    // new object from it (parameters and textures kept) and the old library goes.
+    bool reloadModule(const std::string& name, std::string& error);
+    bool usesModule(const std::string& name) const { return modules_.count(name) > 0; }
+    // Errors from reloads outside the graph (scene file, module), shown until cleared.
+    void setExternalError(const std::string& key, const std::string& message);
+
     SceneRenderer& scene() { return scene_; }
     ModuleLoader& loader() { return *loader_; }
     const ShaderLibrary& shaders() const { return *shaders_; }
@@ -97,7 +108,8 @@ private:
         bool internal = false;
     };
     struct ProgramEntry {
-        gl::ProgramHandle program;
+        ProgramDesc desc;  // as built (defines included), to rebuild on a shader edit
+        gl::ProgramHandle program;  // the last good one; kept while an edit is broken
         std::string error;
         std::vector<std::filesystem::path> dependencies;
     };
@@ -109,6 +121,7 @@ private:
         std::map<std::string, TextureSlot, std::less<>> textures;
         std::map<std::string, gl::FramebufferHandle> framebuffers;
         std::map<std::string, ProgramEntry> programs;
+        uint64_t programGeneration = 0;  // bumped when a program is (re)built: the pass runs again
         std::optional<std::vector<uint64_t>> lastRunKey;
         std::string error;
         gl::GpuTimer timer;
@@ -140,6 +153,7 @@ private:
     gl::VertexArrayHandle emptyVao_;
     struct Fallbacks { gl::Texture black, white, flatNormal, farDepth, black3d; TextureRef refs[5]; } fallbacks_;
     uint64_t versionCounter_ = 0;
+    std::map<std::string, std::string> externalErrors_;
 };
 
 }  // namespace kiln::app

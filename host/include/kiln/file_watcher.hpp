@@ -1,0 +1,59 @@
+// kiln/file_watcher.hpp — one watcher for shaders, pipelines, scenes and modules.
+//
+// inotify on directories (a watch on a file is lost when an editor saves by rename),
+// recursive, polled without blocking once per frame on the render thread: no thread,
+// no locks, and changes apply at a frame boundary by construction. A path is
+// reported once it has been quiet for the debounce interval (trailing edge) and only
+// if its content changed (FNV-1a of the bytes), so a burst of saves is one reload
+// and a touch is none. Editor noise (.swp, 4913, *~, dot-files) is ignored. On queue
+// overflow every known file is re-hashed; a directory deleted and recreated (git
+// checkout) is re-added. Where inotify cannot be used, the same interface polls
+// (nanosecond mtime + size + inode) at most every 100 ms.
+#pragma once
+
+#include <chrono>
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace kiln {
+
+class FileWatcher {
+public:
+    using Clock = std::chrono::steady_clock;
+
+    explicit FileWatcher(std::chrono::milliseconds debounce = std::chrono::milliseconds(50));
+    ~FileWatcher();
+    FileWatcher(const FileWatcher&) = delete;
+    FileWatcher& operator=(const FileWatcher&) = delete;
+
+    // Watches `dir` and (recursively) its subdirectories. Returns false if it does
+    // not exist.
+    bool watch(const std::filesystem::path& dir);
+    // Files whose content changed and that have been quiet for the debounce interval.
+    std::vector<std::filesystem::path> poll();
+    bool usingInotify() const { return fd_ >= 0; }
+
+private:
+    struct Known {
+        uint64_t hash = 0;
+        std::filesystem::file_time_type mtime{};
+        uintmax_t size = 0;
+        uint64_t inode = 0;
+    };
+    void addDirectory(const std::filesystem::path& dir);
+    void noteEvent(const std::filesystem::path& file);
+    void rescan();
+    static bool isNoise(const std::string& name);
+
+    int fd_ = -1;
+    std::chrono::milliseconds debounce_;
+    std::vector<std::filesystem::path> roots_;
+    std::map<int, std::filesystem::path> watches_;  // inotify wd → directory
+    std::map<std::filesystem::path, Known> known_;  // every file seen, by content hash
+    std::map<std::filesystem::path, Clock::time_point> pending_;  // path → last event
+    Clock::time_point lastScan_{};
+};
+
+}  // namespace kiln

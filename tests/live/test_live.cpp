@@ -1,0 +1,205 @@
+// Live editing with the real watcher on real files in a temporary copy of the
+// project's shaders, pipelines and scene. Waits poll frames with a generous timeout
+// and assert behaviour, never speed.
+#include <catch2/catch.hpp>
+
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <sstream>
+#include <thread>
+
+#include "app/app.hpp"
+#include "kiln/image_io.hpp"
+#include "support/headless.hpp"
+
+namespace fs = std::filesystem;
+using namespace kiln;
+
+namespace {
+
+std::string slurp(const fs::path& p) {
+    std::ifstream in(p);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+void writeInPlace(const fs::path& p, const std::string& text) { std::ofstream(p, std::ios::trunc) << text; }
+
+// An editor's save: write a temporary file next to it, then rename over it.
+void writeByRename(const fs::path& p, const std::string& text) {
+    const fs::path tmp = p.parent_path() / ("." + p.filename().string() + ".new");
+    std::ofstream(tmp, std::ios::trunc) << text;
+    fs::rename(tmp, p);
+}
+
+struct Sandbox {
+    fs::path root;
+    app::App app;
+
+    // `prepare` runs on the copied tree before the app starts (e.g. installs a module).
+    explicit Sandbox(const std::string& name, const std::string& pipeline = "default.json",
+                     const std::string& pipelineText = {}, std::function<void(const fs::path&)> prepare = {}) {
+        REQUIRE(test::ensureHeadlessContext());
+        root = fs::path(TEST_OUTPUT_DIR) / (name + "-" + std::to_string(getpid()));
+        fs::remove_all(root);
+        fs::create_directories(root / "modules");
+        fs::create_directories(root / "scenes");
+        fs::copy(fs::path(KILN_SOURCE_DIR) / "shaders", root / "shaders", fs::copy_options::recursive);
+        fs::copy(fs::path(KILN_SOURCE_DIR) / "pipelines", root / "pipelines", fs::copy_options::recursive);
+        fs::copy_file(fs::path(KILN_SOURCE_DIR) / "scenes/cornell.json", root / "scenes/cornell.json");
+        if (!pipelineText.empty()) writeInPlace(root / "pipelines" / pipeline, pipelineText);
+        if (prepare) prepare(root);
+        app::Options o;
+        app::applyDefaults(o);
+        o.headless = true;
+        o.width = o.height = 32;
+        o.paused = true;
+        o.shaderRoot = (root / "shaders").string();
+        o.pipeline = (root / "pipelines" / pipeline).string();
+        o.scene = (root / "scenes/cornell.json").string();
+        o.moduleDir = (root / "modules").string() + ":" + o.moduleDir;
+        std::string error;
+        REQUIRE(app.init(o, error));
+        app.frame();
+    }
+    ~Sandbox() {
+        std::error_code ec;
+        fs::remove_all(root, ec);
+    }
+
+    // Renders frames until `done` holds; false after 10 s.
+    template <class F>
+    bool waitFor(F done) {
+        const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+        while (std::chrono::steady_clock::now() < until) {
+            app.frame();
+            if (done()) return true;
+            std::this_thread::sleep_for(std::chrono::milliseconds(10));
+        }
+        return false;
+    }
+    glm::vec4 centre() {
+        const TextureRef* t = app.displayedTexture();
+        FloatImage img = readTexture(t->id, t->target, t->format, t->width, t->height);
+        const float* p = img.at(img.width / 2, img.height / 2);
+        return {p[0], p[1], p[2], p[3]};
+    }
+    bool errorMentions(const std::string& text) {
+        for (auto& e : app.runtime().activeErrors())
+            if (e.find(text) != std::string::npos) return true;
+        return false;
+    }
+};
+
+bool near(glm::vec4 a, glm::vec3 b) { return glm::length(glm::vec3(a) - b) < 0.02f; }
+
+// composite.frag with its final colour forced to `rgb`.
+std::string forcedComposite(const std::string& original, const char* rgb) {
+    std::string text = original;
+    const size_t end = text.rfind('}');
+    return text.substr(0, end) + "    o_color = vec4(" + rgb + ", 1.0);\n}\n";
+}
+
+}  // namespace
+
+TEST_CASE("a shader edited in place, then by rename, is replaced", "[live][gl]") {
+    Sandbox box("shader-edit");
+    const fs::path frag = box.root / "shaders/composite/composite.frag";
+    const std::string original = slurp(frag);
+    writeInPlace(frag, forcedComposite(original, "1.0, 0.0, 1.0"));
+    CHECK(box.waitFor([&] { return near(box.centre(), {1, 0, 1}); }));
+    writeByRename(frag, forcedComposite(original, "0.0, 1.0, 0.0"));
+    CHECK(box.waitFor([&] { return near(box.centre(), {0, 1, 0}); }));
+    CHECK(box.app.live().shaderReloads == 2);
+}
+
+TEST_CASE("a broken include keeps the last good program and names the file and line", "[live][gl]") {
+    Sandbox box("broken-include");
+    const glm::vec4 before = box.centre();
+    const fs::path light = box.root / "shaders/common/light.glsl";
+    const std::string original = slurp(light);
+    // Line 3 of light.glsl becomes a syntax error.
+    std::string broken = original;
+    size_t second = broken.find('\n', broken.find('\n') + 1);
+    broken.insert(second + 1, "float broken = ;\n");
+    writeInPlace(light, broken);
+    CHECK(box.waitFor([&] { return box.errorMentions("shaders/common/light.glsl:3:"); }));
+    box.app.camera().yaw += 0.0f;
+    CHECK(near(box.centre(), glm::vec3(before)));  // the old program still renders
+    writeInPlace(light, original);
+    CHECK(box.waitFor([&] { return box.app.runtime().activeErrors().empty(); }));
+}
+
+TEST_CASE("a pipeline edit changes the plan and keeps unchanged passes' textures", "[live][gl]") {
+    Sandbox box("pipeline-edit");
+    const fs::path file = box.root / "pipelines/default.json";
+    const GLuint albedo = box.app.runtime().findTexture("gbuffer", "albedo")->id;
+    std::string text = slurp(file);
+    const std::string from = R"({ "id": "shadow", "module": "shadow")";
+    REQUIRE(text.find(from) != std::string::npos);
+    text.replace(text.find(from), from.size(), R"({ "id": "shadow", "module": "shadow", "enabled": false)");
+    writeByRename(file, text);
+    auto shadowState = [&] {
+        const graph::Plan* plan = box.app.runtime().plan();
+        return plan->passes[size_t(plan->find("shadow"))].state;
+    };
+    CHECK(box.waitFor([&] { return shadowState() == graph::PassState::Disabled; }));
+    CHECK(box.app.runtime().findTexture("gbuffer", "albedo")->id == albedo);
+    // An invalid file: the running plan stays, the error names the place.
+    writeInPlace(file, R"({"output": "composite.color", "passes": [{"id": "gbuffer", "module": "gbufer"}]})");
+    CHECK(box.waitFor([&] { return box.errorMentions("passes[0].module"); }));
+    CHECK(shadowState() == graph::PassState::Disabled);
+    CHECK(box.app.runtime().findTexture("gbuffer", "albedo")->id == albedo);
+}
+
+TEST_CASE("a rebuilt module is swapped in with its parameters kept; a broken one is refused", "[live][gl]") {
+    const std::string pipeline = R"({"output": "tint.color",
+        "passes": [{"id": "tint", "module": "live_tint", "params": {"level": 0.25}}]})";
+    const fs::path v1 = fs::path(LIVE_MODULE_BUILDS) / "tint_v1.so", v2 = fs::path(LIVE_MODULE_BUILDS) / "tint_v2.so";
+    Sandbox box("module-swap", "tint.json", pipeline,
+                [&](const fs::path& root) { fs::copy_file(v1, root / "modules/libpass_live_tint.so"); });
+    CHECK(box.waitFor([&] { return near(box.centre(), {1.0f, 0.25f, 0.0f}); }));
+
+    const fs::path installed = box.root / "modules/libpass_live_tint.so";
+    writeByRename(installed, slurp(v2));
+    CHECK(box.waitFor([&] { return near(box.centre(), {0.0f, 0.25f, 1.0f}); }));  // new code, same level
+    CHECK(box.app.live().moduleReloads >= 1);
+
+    writeByRename(installed, "this is not a shared library");
+    CHECK(box.waitFor([&] { return box.errorMentions("libpass_live_tint.so"); }));
+    box.app.camera().yaw += 0.1f;
+    CHECK(near(box.centre(), {0.0f, 0.25f, 1.0f}));  // the previous module keeps running
+}
+
+TEST_CASE("a scene edit resets the world; an invalid scene keeps it", "[live][gl]") {
+    Sandbox box("scene-edit");
+    const fs::path scene = box.root / "scenes/cornell.json";
+    REQUIRE(box.app.world().sim().tumblers().size() == 5);
+    writeByRename(scene, R"({"tumblers": [{"position": [0.0, 0.0]}]})");
+    CHECK(box.waitFor([&] { return box.app.world().sim().tumblers().size() == 1; }));
+    writeInPlace(scene, R"({"tumblers": [{"position": [0.0, 0.0], "colour": [1, 0, 0]}]})");
+    CHECK(box.waitFor([&] { return box.errorMentions("tumblers[0].colour: unknown key"); }));
+    CHECK(box.app.world().sim().tumblers().size() == 1);
+}
+
+TEST_CASE("ten saves in a burst cause one reload", "[live][gl]") {
+    Sandbox box("burst");
+    const fs::path frag = box.root / "shaders/composite/composite.frag";
+    const std::string original = slurp(frag);
+    for (int i = 0; i < 10; ++i) {
+        const std::string rgb = "0.0, " + std::to_string(i / 10.0) + ", 1.0";
+        writeInPlace(frag, forcedComposite(original, rgb.c_str()));
+    }
+    CHECK(box.waitFor([&] { return near(box.centre(), {0.0f, 0.9f, 1.0f}); }));
+    // Let any straggling event settle, then count.
+    for (int i = 0; i < 20; ++i) {
+        box.app.frame();
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    CHECK(box.app.live().shaderReloads == 1);
+}
