@@ -105,23 +105,24 @@ Buffer Buffer::create(GLsizeiptr bytes, const void* data, GLbitfield flags, std:
 }
 
 void GpuTimer::begin() {
-    if (!queries_[0]) {
-        for (auto& q : queries_) {
-            GLuint id = 0;
-            glCreateQueries(GL_TIME_ELAPSED, 1, &id);
-            q = QueryHandle(id);
+    if (!starts_[0]) {
+        for (int i = 0; i < kRing; ++i) {
+            GLuint ids[2] = {};
+            glCreateQueries(GL_TIMESTAMP, 2, ids);
+            starts_[i] = QueryHandle(ids[0]);
+            ends_[i] = QueryHandle(ids[1]);
         }
     }
     // A slot whose result has not arrived yet is skipped this frame rather than
     // waited on: the measurement is lost, the CPU never stalls.
     if (pending_[next_]) return;
-    glBeginQuery(GL_TIME_ELAPSED, queries_[next_].id());
+    glQueryCounter(starts_[next_].id(), GL_TIMESTAMP);
     open_ = true;
 }
 
 void GpuTimer::end() {
     if (!open_) return;
-    glEndQuery(GL_TIME_ELAPSED);
+    glQueryCounter(ends_[next_].id(), GL_TIMESTAMP);
     pending_[next_] = true;
     next_ = (next_ + 1) % kRing;
     open_ = false;
@@ -130,12 +131,13 @@ void GpuTimer::end() {
 bool GpuTimer::poll(int slot, double& ms) {
     if (!pending_[slot]) return false;
     GLint available = 0;
-    glGetQueryObjectiv(queries_[slot].id(), GL_QUERY_RESULT_AVAILABLE, &available);
+    glGetQueryObjectiv(ends_[slot].id(), GL_QUERY_RESULT_AVAILABLE, &available);
     if (!available) return false;
-    GLuint64 ns = 0;
-    glGetQueryObjectui64v(queries_[slot].id(), GL_QUERY_RESULT, &ns);
+    GLuint64 t0 = 0, t1 = 0;
+    glGetQueryObjectui64v(starts_[slot].id(), GL_QUERY_RESULT, &t0);
+    glGetQueryObjectui64v(ends_[slot].id(), GL_QUERY_RESULT, &t1);
     pending_[slot] = false;
-    ms = static_cast<double>(ns) * 1e-6;
+    ms = t1 >= t0 ? static_cast<double>(t1 - t0) * 1e-6 : 0.0;
     return true;
 }
 

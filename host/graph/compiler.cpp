@@ -143,7 +143,9 @@ std::string textureKey(const TextureDecl& t) {
         case SizeRule::Mode::Fixed:
             s += std::to_string(t.size.width) + "x" + std::to_string(t.size.height) + "x" + std::to_string(t.size.depth);
             break;
-        case SizeRule::Mode::FromParam: s += "param:" + t.size.param; break;
+        case SizeRule::Mode::FromParam:
+            s += "param:" + t.size.param + "*" + num(t.size.scale) + "x" + std::to_string(t.size.tiles);
+            break;
     }
     return s + ":mips" + std::to_string(t.mips);
 }

@@ -137,8 +137,9 @@ Extent resolveSize(const TextureDecl& t, int outW, int outH, const ResolvedParam
             break;
         case SizeRule::Mode::FromParam: {
             const int* side = params.get<int>(t.size.param);
-            const int s = side ? std::max(1, *side) : 1;
-            e.w = e.h = s;
+            const int s = side ? std::max(1, int(std::lround(*side * double(t.size.scale)))) : 1;
+            e.w = s * std::max(1, t.size.tiles);
+            e.h = s;
             e.d = is3D ? s : 1;
             break;
         }
@@ -161,7 +162,10 @@ std::string describeSize(const TextureDecl& t, const ResolvedParams& params) {
         }
         case SizeRule::Mode::FromParam: {
             const int* side = params.get<int>(t.size.param);
-            return (side ? std::to_string(*side) : std::string("?")) + (is3D ? "³" : "²") + " (" + t.size.param + ")";
+            std::string d = (side ? std::to_string(*side) : std::string("?")) + (is3D ? "³" : "²") + " (" + t.size.param + ")";
+            if (t.size.scale != 1.0f) d = std::to_string(t.size.scale).substr(0, 4) + "×" + d;
+            if (t.size.tiles > 1) d += " ×" + std::to_string(t.size.tiles) + " tiles";
+            return d;
         }
     }
     return "?";

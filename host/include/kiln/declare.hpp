@@ -47,16 +47,20 @@ struct SizeRule {
     enum class Mode : uint8_t {
         RelativeToOutput,  // scale × the graph's output size (2D)
         Fixed,             // width × height (× depth for 3D)
-        FromParam,         // a square (2D) or cube (3D) whose side is an int parameter
+        FromParam,         // a square (2D) or cube (3D) whose side is an int parameter × scale;
+                           // `tiles` such blocks side by side along x (a slab atlas)
     };
     Mode mode = Mode::RelativeToOutput;
     float scale = 1.0f;
     int width = 0, height = 0, depth = 1;
     std::string param;
+    int tiles = 1;
 
-    static SizeRule relative(float s = 1.0f) { return {Mode::RelativeToOutput, s, 0, 0, 1, {}}; }
-    static SizeRule fixed(int w, int h, int d = 1) { return {Mode::Fixed, 1.0f, w, h, d, {}}; }
-    static SizeRule fromParam(std::string name) { return {Mode::FromParam, 1.0f, 0, 0, 1, std::move(name)}; }
+    static SizeRule relative(float s = 1.0f) { return {Mode::RelativeToOutput, s, 0, 0, 1, {}, 1}; }
+    static SizeRule fixed(int w, int h, int d = 1) { return {Mode::Fixed, 1.0f, w, h, d, {}, 1}; }
+    static SizeRule fromParam(std::string name, float scale = 1.0f, int tiles = 1) {
+        return {Mode::FromParam, scale, 0, 0, 1, std::move(name), tiles};
+    }
 };
 
 // Mip count 1 = no mips; kFullMipChain = down to 1×1(×1).

@@ -113,8 +113,9 @@ private:
     GLsizeiptr size_ = 0;
 };
 
-// A GL_TIME_ELAPSED query ring: begin/end each frame, read results a few frames
-// later without ever stalling the CPU on the GPU.
+// GPU time of a span of commands: a pair of GL_TIMESTAMP queries per frame in a ring,
+// read a few frames later without ever stalling the CPU on the GPU. (Timestamps, not
+// GL_TIME_ELAPSED: llvmpipe returned garbage elapsed times around compute dispatches.)
 class GpuTimer {
 public:
     static constexpr int kRing = 4;
@@ -132,7 +133,7 @@ public:
 
 private:
     bool poll(int slot, double& ms);
-    QueryHandle queries_[kRing];
+    QueryHandle starts_[kRing], ends_[kRing];
     bool pending_[kRing] = {};
     int next_ = 0;
     bool open_ = false;
