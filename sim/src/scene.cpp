@@ -7,6 +7,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "kiln/sim/shape.hpp"
+
 namespace kiln::sim {
 
 using Json = nlohmann::json;
@@ -101,6 +103,7 @@ struct Reader {
     // Unknown keys are typos until proven otherwise.
     bool finish() {
         known.insert("note");
+        known.insert("$schema");
         for (auto& [k, v] : j.items())
             if (!known.count(k)) return fail(at(k), "unknown key");
         return true;
@@ -183,8 +186,18 @@ bool parseScene(const std::string& text, Scene& out, SceneError& error) {
     if (o) {
         Reader r{*o, "box", error, {}};
         if (!r.vec<3>("left", s.box.left, 0, 1) || !r.vec<3>("right", s.box.right, 0, 1) ||
-            !r.vec<3>("other", s.box.other, 0, 1) || !r.finish())
+            !r.vec<3>("other", s.box.other, 0, 1))
             return false;
+        r.known.insert("floor_wood");
+        const Json* w = nullptr;
+        if (!object(*o, "floor_wood", "box.floor_wood", error, w)) return false;
+        if (w) {
+            Reader rw{*w, "box.floor_wood", error, {}};
+            if (!rw.vec<3>("light", s.box.floorWood.light, 0, 1) || !rw.vec<3>("dark", s.box.floorWood.dark, 0, 1) ||
+                !rw.number("ring_frequency", s.box.floorWood.ringFrequency, 0, 1000) || !rw.finish())
+                return false;
+        }
+        if (!r.finish()) return false;
     }
     if (!object(root, "lamp", "lamp", error, o)) return false;
     if (o) {
@@ -240,11 +253,39 @@ bool parseScene(const std::string& text, Scene& out, SceneError& error) {
         if (!r.vec<2>("position", spec.position, -1, 1) || !r.vec<2>("tilt", spec.tilt, -1.5, 1.5) ||
             !r.vec<3>("color", spec.color, 0, 1) || !r.finish())
             return false;
+        if (!t.contains("position")) {
+            error = {path + ".position", "missing (a tumbler needs a position [x, z] on the floor)"};
+            return false;
+        }
         if (std::abs(spec.position.x) > 1.0 - b || std::abs(spec.position.y) > 1.0 - b) {
             error = {path + ".position", "a tumbler of radius " + std::to_string(b) + " at this spot pokes out of the box"};
             return false;
         }
         s.tumblers.push_back(spec);
+    }
+    // With its tilt, the upper sphere must be inside too, and no two tumblers may overlap.
+    {
+        const auto& ts = s.tumblerShape;
+        const RoundCone shape(ts.b, ts.t, ts.alpha);
+        std::vector<std::pair<glm::dvec3, glm::dvec3>> axes;
+        for (size_t i = 0; i < s.tumblers.size(); ++i) {
+            const auto& spec = s.tumblers[i];
+            const glm::dvec3 o(spec.position.x, -1.0 + ts.b, spec.position.y);
+            const glm::dquat q = glm::angleAxis(spec.tilt.y, glm::dvec3(0, 0, 1)) * glm::angleAxis(spec.tilt.x, glm::dvec3(1, 0, 0));
+            const glm::dvec3 top = o + q * glm::dvec3(0, shape.upperCentre(), 0);
+            const std::string path = "tumblers[" + std::to_string(i) + "]";
+            for (int a = 0; a < 3; ++a)
+                if (std::abs(top[a]) > 1.0 - ts.t || (a == 1 && top.y < -1.0 + ts.t)) {
+                    error = {path + ".tilt", "with this tilt the tumbler's upper sphere is outside the box"};
+                    return false;
+                }
+            for (size_t j = 0; j < axes.size(); ++j)
+                if (roundConeSeparation(axes[j].first, axes[j].second, ts.b, ts.t, o, top, ts.b, ts.t).distance < 0.0) {
+                    error = {path + ".position", "overlaps tumblers[" + std::to_string(j) + "]"};
+                    return false;
+                }
+            axes.emplace_back(o, top);
+        }
     }
     if (!balls(root, "marbles", s.marbles, 0.05, error) || !balls(root, "fireballs", s.fireballs, 0.06, error))
         return false;
@@ -254,19 +295,31 @@ bool parseScene(const std::string& text, Scene& out, SceneError& error) {
     return true;
 }
 
-bool loadScene(const std::string& path, Scene& out, std::string& error) {
+SceneResult parseSceneText(const std::string& text) {
+    SceneResult r;
+    r.valid = parseScene(text, r.scene, r.error);
+    return r;
+}
+
+SceneResult loadSceneFile(const std::string& path) {
     std::ifstream in(path, std::ios::binary);
     if (!in) {
-        error = path + ": cannot read scene file";
-        return false;
+        SceneResult r;
+        r.error = {"", "cannot read the scene file"};
+        return r;
     }
     std::stringstream ss;
     ss << in.rdbuf();
-    SceneError e;
-    if (!parseScene(ss.str(), out, e)) {
-        error = e.toString(path);
+    return parseSceneText(ss.str());
+}
+
+bool loadScene(const std::string& path, Scene& out, std::string& error) {
+    SceneResult r = loadSceneFile(path);
+    if (!r) {
+        error = r.error.toString(path);
         return false;
     }
+    out = std::move(r.scene);
     return true;
 }
 

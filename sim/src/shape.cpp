@@ -1,5 +1,6 @@
 #include "kiln/sim/shape.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <vector>
@@ -77,6 +78,14 @@ Vec3 RoundCone::gradient(const Vec3& p) const {
     return {c_ * p.x / r, s_, c_ * p.z / r};
 }
 
+double RoundCone::sdfWorld(const Vec3& p, const Vec3& position, const Quat& q) const {
+    return sdf(glm::inverse(q) * (p - position));
+}
+
+Vec3 RoundCone::gradientWorld(const Vec3& p, const Vec3& position, const Quat& q) const {
+    return q * gradient(glm::inverse(q) * (p - position));
+}
+
 MassProperties RoundCone::massProperties(double mass) const {
     // R² per piece as a quadratic in y.
     const double ts = yt_ + t_ * s_;
@@ -117,6 +126,95 @@ MassProperties RoundCone::integratedMassProperties(double mass, int intervals) c
         }
     }
     return fromMoments(m, mass);
+}
+
+namespace {
+
+// Distance from x to the round cone a0→a1 (radii r0, r1) and the axis parameter u of
+// the ball B(P(u), r(u)) that realises it (its surface holds the nearest point).
+double coneDistance(const Vec3& x, const Vec3& a0, const Vec3& a1, double r0, double r1, double& u) {
+    if (r1 > r0) {  // work with the larger sphere first, then map u back
+        const double d = coneDistance(x, a1, a0, r1, r0, u);
+        u = 1.0 - u;
+        return d;
+    }
+    Vec3 axis = a1 - a0;
+    const double h = glm::length(axis);
+    if (h < 1e-12 || r0 - r1 >= h) {  // one sphere contains the other
+        u = 0.0;
+        return glm::length(x - a0) - r0;
+    }
+    axis /= h;
+    const Vec3 d = x - a0;
+    const double y = glm::dot(d, axis);
+    const double r = glm::length(d - y * axis);
+    const double s = (r0 - r1) / h, c = std::sqrt(1.0 - s * s);
+    const double k = y * c - r * s;
+    if (k < 0.0) {
+        u = 0.0;
+        return std::sqrt(r * r + y * y) - r0;
+    }
+    if (k > c * h) {
+        u = 1.0;
+        return std::sqrt(r * r + (y - h) * (y - h)) - r1;
+    }
+    // Side: the normal through x meets the axis at y − r·tan α.
+    u = std::clamp((y - r * s / c) / h, 0.0, 1.0);
+    return r * c + y * s - r0;
+}
+
+}  // namespace
+
+double roundConeDistance(const Vec3& x, const Vec3& a0, const Vec3& a1, double r0, double r1) {
+    double u;
+    return coneDistance(x, a0, a1, r0, r1, u);
+}
+
+ConeSeparation roundConeSeparation(const Vec3& a0, const Vec3& a1, double ra0, double ra1, const Vec3& b0,
+                                   const Vec3& b1, double rb0, double rb1) {
+    // g(s) = min_u f(s, u) = dist(P_A(s), B) − r_A(s) is convex (a partial minimum of a
+    // jointly convex function): golden-section search on s, closed form for u.
+    auto g = [&](double s) {
+        double u;
+        return coneDistance(a0 + s * (a1 - a0), b0, b1, rb0, rb1, u) - (ra0 + s * (ra1 - ra0));
+    };
+    const double phi = 0.6180339887498949;
+    double lo = 0.0, hi = 1.0;
+    double x1 = hi - phi * (hi - lo), x2 = lo + phi * (hi - lo), f1 = g(x1), f2 = g(x2);
+    for (int i = 0; i < 64; ++i) {  // 0.618^64 ≈ 4e-14 of the axis
+        if (f1 < f2) {
+            hi = x2, x2 = x1, f2 = f1, x1 = hi - phi * (hi - lo), f1 = g(x1);
+        } else {
+            lo = x1, x1 = x2, f1 = f2, x2 = lo + phi * (hi - lo), f2 = g(x2);
+        }
+    }
+    ConeSeparation r;
+    r.s = 0.5 * (lo + hi);
+    double best = g(r.s);
+    for (double end : {0.0, 1.0}) {  // the minimum may sit on an end (flat or monotone g)
+        const double ge = g(end);
+        if (ge < best) best = ge, r.s = end;
+    }
+    r.onA = a0 + r.s * (a1 - a0);
+    r.distance = coneDistance(r.onA, b0, b1, rb0, rb1, r.u) - (ra0 + r.s * (ra1 - ra0));
+    r.onB = b0 + r.u * (b1 - b0);
+    Vec3 d = r.onB - r.onA;
+    double len = glm::length(d);
+    if (len < 1e-12) {  // axes meet: no preferred direction; use the base centres, then x
+        d = b0 - a0;
+        len = glm::length(d);
+        if (len < 1e-12) d = Vec3(1, 0, 0), len = 1.0;
+    }
+    r.normal = d / len;
+    r.witnessA = r.onA + (ra0 + r.s * (ra1 - ra0)) * r.normal;
+    r.witnessB = r.onB - (rb0 + r.u * (rb1 - rb0)) * r.normal;
+    return r;
+}
+
+double fourSphereSeparation(const Vec3& a0, const Vec3& a1, double ra0, double ra1, const Vec3& b0,
+                            const Vec3& b1, double rb0, double rb1) {
+    return std::min({roundConeDistance(a0, b0, b1, rb0, rb1) - ra0, roundConeDistance(a1, b0, b1, rb0, rb1) - ra1,
+                     roundConeDistance(b0, a0, a1, ra0, ra1) - rb0, roundConeDistance(b1, a0, a1, ra0, ra1) - rb1});
 }
 
 }  // namespace kiln::sim

@@ -3,35 +3,40 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 namespace kiln::sim {
 
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-constexpr size_t kMaxParticles = 4096;
 constexpr double kFireRate = 400.0;        // particles per second per fireball (SPEC §5)
 constexpr double kFireLife = 0.45;
-constexpr double kBurnDuration = 1.2;      // seconds a marble burns before turning to ash
 constexpr double kTumblerRestitution = 0.5;
 
 Mat3 skew(const Vec3& r) { return Mat3(0, r.z, -r.y, -r.z, 0, r.x, r.y, -r.x, 0); }  // column-major: [r]×
 
-// Exact distance from X to a round cone with axis a0→a1 and end radii r0, r1.
-double roundConeDistance(const Vec3& x, const Vec3& a0, const Vec3& a1, double r0, double r1) {
-    Vec3 axis = a1 - a0;
-    double h = glm::length(axis);
-    if (r1 > r0) return roundConeDistance(x, a1, a0, r1, r0);
-    if (h < 1e-12 || r0 - r1 >= h) return glm::length(x - a0) - r0;  // one sphere contains the other
-    axis /= h;
-    const Vec3 d = x - a0;
-    const double y = glm::dot(d, axis);
-    const double r = glm::length(d - y * axis);
-    const double s = (r0 - r1) / h, c = std::sqrt(1.0 - s * s);
-    const double k = -r * s + y * c;
-    if (k < 0.0) return std::sqrt(r * r + y * y) - r0;
-    if (k > c * h) return std::sqrt(r * r + (y - h) * (y - h)) - r1;
-    return r * c + y * s - r0;
+// Distance between segments p0p1 and q0q1 (Ericson, Real-Time Collision Detection 5.1.9).
+double segmentDistance(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1) {
+    const Vec3 d1 = p1 - p0, d2 = q1 - q0, r = p0 - q0;
+    const double a = glm::dot(d1, d1), e = glm::dot(d2, d2), f = glm::dot(d2, r);
+    double s = 0, t = 0;
+    if (a <= 1e-24 && e <= 1e-24) return glm::length(r);
+    if (a <= 1e-24) {
+        t = std::clamp(f / e, 0.0, 1.0);
+    } else {
+        const double c = glm::dot(d1, r);
+        if (e <= 1e-24) {
+            s = std::clamp(-c / a, 0.0, 1.0);
+        } else {
+            const double b = glm::dot(d1, d2), denom = a * e - b * b;
+            s = denom > 1e-24 ? std::clamp((b * f - c * e) / denom, 0.0, 1.0) : 0.0;
+            t = (b * s + f) / e;
+            if (t < 0.0) t = 0.0, s = std::clamp(-c / a, 0.0, 1.0);
+            else if (t > 1.0) t = 1.0, s = std::clamp((b - c) / a, 0.0, 1.0);
+        }
+    }
+    return glm::length(p0 + s * d1 - (q0 + t * d2));
 }
 
 uint64_t fnv(uint64_t h, const void* data, size_t n) {
@@ -62,7 +67,10 @@ uint32_t Rng::next() {
 
 Vec3 Rng::inUnitBall() {
     for (;;) {
-        Vec3 p(uniform(-1, 1), uniform(-1, 1), uniform(-1, 1));
+        Vec3 p;  // one draw per statement: argument evaluation order is unspecified
+        p.x = uniform(-1, 1);
+        p.y = uniform(-1, 1);
+        p.z = uniform(-1, 1);
         if (glm::dot(p, p) <= 1.0) return p;
     }
 }
@@ -105,26 +113,77 @@ Vec3 Particle::emission() const {
     return Vec3(0.0);
 }
 
-ConeSeparation roundConeSeparation(const Vec3& a0, const Vec3& a1, double ra0, double ra1, const Vec3& b0,
-                                   const Vec3& b1, double rb0, double rb1) {
-    // f(s) = dist(A's axis point at s, cone B) − r_A(s) is convex in s (PHYSICS.md):
-    // golden-section search on s, exact round-cone distance for the inner minimum.
-    auto f = [&](double s) { return roundConeDistance(a0 + s * (a1 - a0), b0, b1, rb0, rb1) - (ra0 + s * (ra1 - ra0)); };
-    const double g = 0.6180339887498949;
-    double lo = 0.0, hi = 1.0, x1 = hi - g * (hi - lo), x2 = lo + g * (hi - lo), f1 = f(x1), f2 = f(x2);
-    for (int i = 0; i < 60; ++i) {
-        if (f1 < f2) hi = x2, x2 = x1, f2 = f1, x1 = hi - g * (hi - lo), f1 = f(x1);
-        else lo = x1, x1 = x2, f1 = f2, x2 = lo + g * (hi - lo), f2 = f(x2);
+Vec3 Ball::albedo() const {
+    if (kind != BallKind::Burning) return color;
+    return color * (1.0 - std::min(1.0, burnTime / kBurnDuration));
+}
+
+Vec3 Ball::emissiveColor() const {
+    switch (kind) {
+        case BallKind::Marble: return Vec3(0.0);
+        case BallKind::Fireball: return color;
+        case BallKind::Burning: return Vec3(1.0, 0.4, 0.1);
     }
-    double s = 0.5 * (lo + hi), fs = f(s);
-    if (f(0.0) < fs) s = 0.0, fs = f(0.0);
-    if (f(1.0) < fs) s = 1.0, fs = f(1.0);
-    const Vec3 onA = a0 + s * (a1 - a0);
-    // The matching parameter on B: the axis point nearest to onA's projection.
-    const Vec3 axisB = b1 - b0;
-    const double len2 = glm::dot(axisB, axisB);
-    const double u = len2 > 0 ? std::clamp(glm::dot(onA - b0, axisB) / len2, 0.0, 1.0) : 0.0;
-    return {fs, s, u, onA, b0 + u * axisB};
+    return Vec3(0.0);
+}
+
+double Ball::emissiveStrength() const {
+    switch (kind) {
+        case BallKind::Marble: return 0.0;
+        case BallKind::Fireball: return 6.0;
+        case BallKind::Burning: return 3.0 * (1.0 - 0.7 * std::min(1.0, burnTime / kBurnDuration));
+    }
+    return 0.0;
+}
+
+Vec3 solveImpulse(const Mat3& K, const Vec3& dv) {
+    const double tr = K[0][0] + K[1][1] + K[2][2];
+    if (!(tr > 0.0) || !std::isfinite(tr)) return Vec3(0.0);
+    const double det = glm::determinant(K);
+    // Well conditioned relative to its scale (det ~ (tr/3)³ for an isotropic K).
+    const double scale = tr / 3.0;
+    if (det > 1e-9 * scale * scale * scale) return glm::inverse(K) * dv;
+    // (Nearly) singular: the pseudo-inverse through a Jacobi eigen-decomposition,
+    // dropping eigenvalues below 1e-9·λ_max — the minimum-norm least-squares impulse.
+    double a[3][3];
+    for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) a[r][c] = 0.5 * (K[c][r] + K[r][c]);
+    double v[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    for (int sweep = 0; sweep < 50; ++sweep) {
+        const double off = a[0][1] * a[0][1] + a[0][2] * a[0][2] + a[1][2] * a[1][2];
+        if (off < 1e-30 * tr * tr) break;
+        for (int p = 0; p < 2; ++p)
+            for (int q = p + 1; q < 3; ++q) {
+                if (a[p][q] == 0.0) continue;
+                const double theta = 0.5 * (a[q][q] - a[p][p]) / a[p][q];
+                const double t = (theta >= 0 ? 1.0 : -1.0) / (std::abs(theta) + std::sqrt(theta * theta + 1.0));
+                const double c = 1.0 / std::sqrt(t * t + 1.0), sn = t * c;
+                for (int k = 0; k < 3; ++k) {  // A ← Jᵀ A J
+                    const double akp = a[k][p], akq = a[k][q];
+                    a[k][p] = c * akp - sn * akq;
+                    a[k][q] = sn * akp + c * akq;
+                }
+                for (int k = 0; k < 3; ++k) {
+                    const double apk = a[p][k], aqk = a[q][k];
+                    a[p][k] = c * apk - sn * aqk;
+                    a[q][k] = sn * apk + c * aqk;
+                }
+                for (int k = 0; k < 3; ++k) {  // V ← V J
+                    const double vkp = v[k][p], vkq = v[k][q];
+                    v[k][p] = c * vkp - sn * vkq;
+                    v[k][q] = sn * vkp + c * vkq;
+                }
+            }
+    }
+    const double lmax = std::max({a[0][0], a[1][1], a[2][2]});
+    Vec3 j(0.0);
+    for (int e = 0; e < 3; ++e) {
+        const double lambda = a[e][e];
+        if (!(lambda > 1e-9 * lmax)) continue;
+        const Vec3 ve(v[0][e], v[1][e], v[2][e]);
+        j += (glm::dot(ve, dv) / lambda) * ve;
+    }
+    return j;
 }
 
 // ---- world ----------------------------------------------------------------------
@@ -136,7 +195,8 @@ void World::reset(const Scene& scene) {
     mass_ = shape_.massProperties(ts.mass);
     if (scene.physics.tumblerMode == TumblerMode::Accurate) {
         // A weighted base: the centre of mass sits h below O, and the inertia about it
-        // is the uniform body's own (PHYSICS.md, "Rocking").
+        // is I_G = I_O − m·y_G², the uniform body's inertia moved from O to its own
+        // centroid by the parallel-axis theorem — the I_G of PHYSICS.md's rocking example.
         comLocal_ = Vec3(0, -scene.physics.ballastH, 0);
         inertiaCom_ = mass_.inertiaCom;
     } else {
@@ -153,11 +213,11 @@ void World::reset(const Scene& scene) {
         tumblers_.push_back(t);
     }
     balls_.clear();
-    for (auto& m : scene.marbles) balls_.push_back({m.position, m.velocity, Vec3(0.0), m.radius, BallKind::Marble, m.color, 0.0});
+    for (auto& m : scene.marbles) balls_.push_back({m.position, m.velocity, Vec3(0.0), m.radius, BallKind::Marble, m.color});
     for (auto& f : scene.fireballs)
-        balls_.push_back({f.position, f.velocity, Vec3(0.0), f.radius, BallKind::Fireball, f.color, 0.0});
+        balls_.push_back({f.position, f.velocity, Vec3(0.0), f.radius, BallKind::Fireball, f.color});
     particles_.clear();
-    fireAccumulator_.clear();
+    particles_.reserve(kMaxParticles);  // the pool: allocated once, never grows
     rng_.reseed(scene.physics.seed);
     time_ = 0.0;
     steps_ = 0;
@@ -222,30 +282,20 @@ void World::step() {
 void World::substep(double dt) {
     for (int i = 0; i < int(tumblers_.size()); ++i) stepTumbler(i, dt);
     for (int a = 0; a < int(tumblers_.size()); ++a)
-        for (int b = a + 1; b < int(tumblers_.size()); ++b) collideTumblerPair(a, b);
+        for (int b = a + 1; b < int(tumblers_.size()); ++b) resolveTumblerPair(a, b);
     for (int i = 0; i < int(tumblers_.size()); ++i) {
         collideTumblerWalls(i);
         collideTumblerFloor(i);
     }
+    ballsBefore_.resize(balls_.size());
+    for (size_t i = 0; i < balls_.size(); ++i) ballsBefore_[i] = balls_[i].position;
     for (auto& ball : balls_) stepBall(ball, dt);
     if (!balls_.empty()) bodiesMoved_ = true;
     for (int i = 0; i < int(balls_.size()); ++i) {
         collideBallLamp(balls_[size_t(i)]);
         collideBallTumblers(i);
     }
-    // Broad phase: balls sorted by x; only neighbours within the largest diameter are tested.
-    std::vector<int> order(balls_.size());
-    for (size_t i = 0; i < order.size(); ++i) order[i] = int(i);
-    std::sort(order.begin(), order.end(), [&](int a, int b) {
-        return balls_[size_t(a)].position.x < balls_[size_t(b)].position.x || (balls_[size_t(a)].position.x == balls_[size_t(b)].position.x && a < b);
-    });
-    double maxR = 0;
-    for (auto& b : balls_) maxR = std::max(maxR, b.radius);
-    for (size_t i = 0; i < order.size(); ++i)
-        for (size_t j = i + 1; j < order.size(); ++j) {
-            if (balls_[size_t(order[j])].position.x - balls_[size_t(order[i])].position.x > 2 * maxR) break;
-            collideBallPair(order[i], order[j]);
-        }
+    collideBallPairs();
     // Contact pushes may nudge a ball past a wall: containment is exact per sphere.
     for (auto& b : balls_) b.position = glm::clamp(b.position, Vec3(b.radius - 1.0), Vec3(1.0 - b.radius));
     // Burning marbles turn to ash.
@@ -285,13 +335,10 @@ void World::stepTumbler(int i, double dt) {
     const Vec3 rc = contact - g;
     const Vec3 vc = vG + glm::cross(w, rc);
     const Mat3 K = Mat3(1.0 / m) - skew(rc) * invI * skew(rc);
-    const double det = glm::determinant(K);
-    if (std::abs(det) > 1e-12) {
-        const Vec3 j = glm::inverse(K) * (-vc);
-        if (j.y >= 0.0) {
-            vG += j / m;
-            w += invI * glm::cross(rc, j);
-        }
+    const Vec3 j = solveImpulse(K, -vc);
+    if (j.y >= 0.0) {
+        vG += j / m;
+        w += invI * glm::cross(rc, j);
     }
     // Friction damps rocking and rolling (SPEC §4.1).
     if (ph.friction > 0) {
@@ -308,8 +355,10 @@ void World::stepTumbler(int i, double dt) {
     // Rolling without slipping fixes O's horizontal velocity by ω.
     t.velocity = Vec3(-b * w.z, 0.0, b * w.x);
 
-    const double tilt = std::acos(std::clamp(t.axis().y, -1.0, 1.0));
-    if (glm::length(t.velocity) < 2e-3 && glm::length(w) < 2e-2 && tilt < 0.02) {
+    // Sleep after 0.5 s below the thresholds: upright at rest, or lying on the floor
+    // (the floor contact zeroes it every sub-step). A rocking tumbler passes through
+    // ω ≈ 0 only for an instant, so the continuous 0.5 s keeps it awake.
+    if (glm::length(t.velocity) < 2e-3 && glm::length(w) < 2e-2) {
         t.restTime += dt;
         if (t.restTime > 0.5) {
             t.asleep = true;
@@ -347,77 +396,82 @@ void World::collideTumblerWalls(int i) {
 }
 
 void World::collideTumblerFloor(int i) {
-    // Only the upper sphere can reach the floor (the toy fell over): hold it at the
-    // floor, stop it, and let it right itself from there.
+    // Only the upper sphere can reach the floor (the toy fell over): it lies there when
+    // axis·y = (t − b)/y_t (≈ 110° for the default shape). Rotate it back exactly onto
+    // the floor about the horizontal axis of its tilt, stop it, and let gravity (or the
+    // seed's restoring impulse) right it from there.
     Tumbler& t = tumblers_[size_t(i)];
-    const Vec3 upper = t.upperCentre(shape_);
-    const double floorGap = upper.y - shape_.t() - (-1.0);
-    if (floorGap >= 0.0) return;
+    const double cosLying = (shape_.t() - shape_.b()) / shape_.upperCentre();
     const Vec3 axis = t.axis();
-    // Rotate about the horizontal axis perpendicular to the tilt until the gap closes.
-    Vec3 tiltAxis = glm::cross(axis, Vec3(0, 1, 0));
+    if (axis.y >= cosLying) return;
+    Vec3 tiltAxis = glm::cross(axis, Vec3(0, 1, 0));  // rotating about it raises the axis
     const double len = glm::length(tiltAxis);
-    if (len < 1e-9) return;
-    tiltAxis /= len;
-    const double lever = shape_.upperCentre();
-    const double angle = -floorGap / std::max(lever, 1e-6);
+    if (len < 1e-12) tiltAxis = Vec3(1, 0, 0);  // upside down: any horizontal axis
+    else tiltAxis /= len;
+    const double angle = std::acos(std::clamp(axis.y, -1.0, 1.0)) - std::acos(cosLying);
     t.orientation = glm::normalize(glm::angleAxis(angle, tiltAxis) * t.orientation);
     t.velocity = Vec3(0.0);
     t.angularVelocity = Vec3(0.0);
 }
 
-void World::collideTumblerPair(int a, int b) {
+double World::resolveTumblerPair(int a, int b) {
     Tumbler& ta = tumblers_[size_t(a)];
     Tumbler& tb = tumblers_[size_t(b)];
-    if (ta.asleep && tb.asleep) return;
+    const double inf = std::numeric_limits<double>::infinity();
+    if (ta.asleep && tb.asleep) return inf;
     const double reach = 2.0 * (shape_.top() + shape_.b());
-    if (glm::length(ta.position - tb.position) > reach) return;
+    if (glm::length(ta.position - tb.position) > reach) return inf;
 
+    const Vec3 ua = ta.upperCentre(shape_), ub = tb.upperCentre(shape_);
+    const double rb = shape_.b(), rt = shape_.t();
+    // Cheap rejection: every point of a body is within b of its axis segment.
+    if (segmentDistance(ta.position, ua, tb.position, ub) > 2.0 * rb) return inf;
     Vec3 n(0.0), h(0.0);
-    double depth = 0.0;
+    double separation = 0.0;
     if (scene_.physics.tumblerContact == TumblerContact::Exact) {
-        ConeSeparation sep = roundConeSeparation(ta.position, ta.upperCentre(shape_), shape_.b(), shape_.t(), tb.position,
-                                                 tb.upperCentre(shape_), shape_.b(), shape_.t());
-        if (sep.distance >= 0.0) return;
-        const double rA = shape_.b() + sep.s * (shape_.t() - shape_.b());
-        n = tumblerNormal(b, sep.onA) * -1.0;  // from A towards B
-        const double dB = tumblerSdf(b, sep.onA);
-        h = 0.5 * ((sep.onA + n * rA) + (sep.onA + n * dB));
-        depth = -sep.distance;
+        // min over s,u of |P_A(s) − P_B(u)| − r_A(s) − r_B(u): contact at the midpoint of
+        // the two witness points, normal along the line between the axis points.
+        const ConeSeparation sep = roundConeSeparation(ta.position, ua, rb, rt, tb.position, ub, rb, rt);
+        separation = sep.distance;
+        if (separation >= 0.0) return separation;
+        n = sep.normal;
+        h = 0.5 * (sep.witnessA + sep.witnessB);
     } else {
-        // The seed's approximation: each end sphere against the other's exact SDF.
+        // The seed's approximation: each end sphere against the other's exact SDF;
+        // contact points and normals averaged over the spheres that touch.
         int hits = 0;
-        auto test = [&](int self, int other, const Vec3& centre, double radius, double sign) {
+        separation = inf;
+        auto test = [&](int other, const Vec3& centre, double radius, double sign) {
             const double d = tumblerSdf(other, centre);
+            separation = std::min(separation, d - radius);
             if (d - radius >= 0.0) return;
             const Vec3 g = tumblerNormal(other, centre);
-            n += sign * g;
+            n += sign * g;  // sign makes it point from A to B
             h += centre - g * d;
-            depth = std::max(depth, radius - d);
             ++hits;
-            (void)self;
         };
-        test(a, b, ta.position, shape_.b(), -1.0);
-        test(a, b, ta.upperCentre(shape_), shape_.t(), -1.0);
-        test(b, a, tb.position, shape_.b(), 1.0);
-        test(b, a, tb.upperCentre(shape_), shape_.t(), 1.0);
-        if (hits == 0) return;
+        test(b, ta.position, rb, -1.0);
+        test(b, ua, rt, -1.0);
+        test(a, tb.position, rb, 1.0);
+        test(a, ub, rt, 1.0);
+        if (hits == 0) return separation;
         h /= double(hits);
+        const double nl = glm::length(n);
+        n = nl > 1e-9 ? n / nl : Vec3(0.0);
     }
-    double nl = glm::length(n);
-    if (nl < 1e-9) {  // coincident: separate along x
+    if (glm::length(n) < 0.5) {  // coincident: no direction; separate along x
         n = Vec3(ta.position.x <= tb.position.x ? 1.0 : -1.0, 0, 0);
-        nl = 1.0;
+        if (ta.position.x == tb.position.x) n = Vec3(a < b ? 1.0 : -1.0, 0, 0);
     }
-    n /= nl;
-    // Separate on the floor plane, half each.
+    // Separate on the floor plane, half each (both stay on the floor).
     Vec3 nh(n.x, 0.0, n.z);
     const double nhl = glm::length(nh);
     nh = nhl > 1e-9 ? nh / nhl : Vec3(1, 0, 0);
+    const double depth = std::min(-separation, 2.0 * shape_.b());
     ta.position -= nh * (0.5 * depth);
     tb.position += nh * (0.5 * depth);
     // Normal impulse from the relative velocity at the contact: the scalar form of
-    // j = K⁻¹Δv along n, which stays defined when K itself is singular.
+    // j = K⁻¹Δv along n (n·K·n > 0 always, so it never divides by zero).
     const Vec3 vRel = pointVelocity(b, h) - pointVelocity(a, h);
     const double vn = glm::dot(vRel, n);
     if (vn < 0.0) {
@@ -431,23 +485,28 @@ void World::collideTumblerPair(int a, int b) {
     }
     wake(a);
     wake(b);
+    return separation;
 }
 
 void World::stepBall(Ball& ball, double dt) {
-    const bool gravity = ball.kind != BallKind::Fireball;
-    const Vec3 acc(0.0, gravity ? -scene_.physics.gravity : 0.0, 0.0);
-    Vec3 v1 = ball.velocity + acc * dt;
-    Vec3 x1 = ball.position + v1 * dt;
+    const double gy = ball.kind == BallKind::Fireball ? 0.0 : -scene_.physics.gravity;
+    const Vec3 v0 = ball.velocity, x0 = ball.position;
+    Vec3 v1 = v0;
+    v1.y += gy * dt;
+    Vec3 x1 = x0 + v1 * dt;
     const double limit = 1.0 - ball.radius;
     for (int k = 0; k < 3; ++k) {
         if (std::abs(x1[k]) <= limit) continue;
-        // Penetrate, then mirror: the part of the step beyond the wall is reflected
-        // back, as is the velocity. Energy swings within O(g·|v|·dt) per bounce and
-        // shows no trend (PHYSICS.md); reflecting the velocity after the gravity kick
-        // without mirroring the position gains energy at every bounce.
+        // Time-symmetric bounce: a step that would cross the wall becomes the time
+        // reverse of the step that came in, v₁ = −v₀, x₁ = x₀ + v₁Δt. It keeps E′ =
+        // ½v² + g·y − ½gΔt·v_y exactly (PHYSICS.md), never lets the ball through (it
+        // moves away from the wall from inside), and needs no sub-step time of impact.
         const double wall = x1[k] > 0 ? limit : -limit;
-        x1[k] = std::clamp(2.0 * wall - x1[k], -limit, limit);
-        v1[k] = -v1[k];
+        v1[k] = -v0[k];
+        x1[k] = x0[k] + v1[k] * dt;
+        // A ball creeping along the floor (|v_y| < gΔt) may still cross, and one moving
+        // more than the box per step would cross the opposite wall: hold it inside.
+        x1[k] = std::clamp(x1[k], -limit, limit);
         Vec3 normal(0.0);
         normal[k] = wall > 0 ? -1.0 : 1.0;
         ball.angularVelocity = glm::cross(normal, v1) / ball.radius;  // rolling on the wall
@@ -472,7 +531,31 @@ void World::collideBallLamp(Ball& ball) {
 }
 
 void World::collideBallTumblers(int bi) {
-    for (int i = 0; i < int(tumblers_.size()); ++i) resolveBallTumblerContact(bi, i);
+    for (int i = 0; i < int(tumblers_.size()); ++i) {
+        Ball& ball = balls_[size_t(bi)];
+        // A fast ball (moved more than its radius this sub-step) could jump over a
+        // tumbler: conservative advancement along its path finds the first touch.
+        const Vec3 from = ballsBefore_[size_t(bi)], path = ball.position - from;
+        const double len = glm::length(path);
+        if (len > ball.radius) {
+            const Tumbler& t = tumblers_[size_t(i)];
+            // Bounding sphere about O (every point of the body is within y_t + t of it).
+            const double s = std::clamp(glm::dot(t.position - from, path) / (len * len), 0.0, 1.0);
+            if (glm::length(from + s * path - t.position) < shape_.top() + ball.radius) {
+                double along = 0.0;  // metres along the path
+                for (int iter = 0; iter < 64 && along < len; ++iter) {
+                    const double d = tumblerSdf(i, from + path * (along / len)) - ball.radius;
+                    if (d < 1e-4) {
+                        // Touching: stop a hair inside, so the contact below resolves it.
+                        ball.position = from + path * (std::min(len, along + 2e-4) / len);
+                        break;
+                    }
+                    along += d;
+                }
+            }
+        }
+        resolveBallTumblerContact(bi, i);
+    }
 }
 
 bool World::resolveBallTumblerContact(int bi, int i) {
@@ -498,14 +581,59 @@ bool World::resolveBallTumblerContact(int bi, int i) {
     return true;
 }
 
-void World::collideBallPair(int ai, int bi) {
+void World::collideBallPairs() {
+    const int n = int(balls_.size());
+    if (n < 2) return;
+    // Uniform grid over the box, cell ≥ the largest diameter: a ball can only touch
+    // balls in its own and the 26 neighbouring cells. Counting sort keeps it O(n) and
+    // deterministic (pairs are visited in ball index order).
+    double maxR = 0;
+    for (auto& b : balls_) maxR = std::max(maxR, b.radius);
+    const int dim = std::clamp(int(2.0 / (2.0 * maxR)), 1, 64);
+    const double inv = dim / 2.0;
+    auto cellOf = [&](const Vec3& p, int axis) { return std::clamp(int((p[axis] + 1.0) * inv), 0, dim - 1); };
+    gridCells_.resize(size_t(n));
+    gridStart_.assign(size_t(dim) * dim * dim + 1, 0);
+    gridOrder_.resize(size_t(n));
+    for (int i = 0; i < n; ++i) {
+        const Vec3& p = balls_[size_t(i)].position;
+        gridCells_[size_t(i)] = (cellOf(p, 0) * dim + cellOf(p, 1)) * dim + cellOf(p, 2);
+        ++gridStart_[size_t(gridCells_[size_t(i)]) + 1];
+    }
+    for (size_t c = 1; c < gridStart_.size(); ++c) gridStart_[c] += gridStart_[c - 1];
+    gridCursor_.assign(gridStart_.begin(), gridStart_.end() - 1);
+    for (int i = 0; i < n; ++i) gridOrder_[size_t(gridCursor_[size_t(gridCells_[size_t(i)])]++)] = i;
+    // Each ball against later balls in its own cell, and against every ball in the 13
+    // "forward" neighbour cells (the other 13 see this cell as their forward one).
+    for (int i = 0; i < n; ++i) {
+        const int c = gridCells_[size_t(i)];
+        const int cx = c / (dim * dim), cy = (c / dim) % dim, cz = c % dim;
+        for (int k = gridStart_[size_t(c)]; k < gridStart_[size_t(c) + 1]; ++k) {
+            const int j = gridOrder_[size_t(k)];
+            if (j > i) resolveBallBallContact(i, j);
+        }
+        for (int dx = 0; dx <= 1; ++dx)
+            for (int dy = dx ? -1 : 0; dy <= 1; ++dy)
+                for (int dz = (dx || dy) ? -1 : 1; dz <= 1; ++dz) {
+                    const int x = cx + dx, y = cy + dy, z = cz + dz;
+                    if (x >= dim || y < 0 || y >= dim || z < 0 || z >= dim) continue;
+                    const int cell = (x * dim + y) * dim + z;
+                    for (int k = gridStart_[size_t(cell)]; k < gridStart_[size_t(cell) + 1]; ++k)
+                        resolveBallBallContact(i, gridOrder_[size_t(k)]);
+                }
+    }
+}
+
+bool World::resolveBallBallContact(int ai, int bi) {
     Ball& a = balls_[size_t(ai)];
     Ball& b = balls_[size_t(bi)];
     Vec3 d = b.position - a.position;
     const double reach = a.radius + b.radius;
-    double dist = glm::length(d);
-    if (dist >= reach) return;
-    const Vec3 n = dist > 1e-12 ? d / dist : Vec3(1, 0, 0);
+    const double dist2 = glm::dot(d, d);
+    if (dist2 >= reach * reach) return false;
+    const double dist = std::sqrt(dist2);
+    // Coincident centres: no direction; separate along x (deterministic by index).
+    const Vec3 n = dist > 1e-12 ? d / dist : Vec3(ai < bi ? 1.0 : -1.0, 0, 0);
     const double ma = a.mass(), mb = b.mass();
     // Separate in proportion to the other's mass (the centre of mass stays put).
     const double pen = reach - dist;
@@ -518,9 +646,11 @@ void World::collideBallPair(int ai, int bi) {
         b.velocity += (j / mb) * n;
     }
     const bool aFire = a.kind == BallKind::Fireball, bFire = b.kind == BallKind::Fireball;
-    if (aFire && b.kind == BallKind::Marble) ignite(bi, a.position + n * a.radius);
-    if (bFire && a.kind == BallKind::Marble) ignite(ai, b.position - n * b.radius);
-    if (aFire || bFire) emitSparks(a.position + n * a.radius, n, 8);
+    const Vec3 at = a.position + n * a.radius;
+    if (aFire && b.kind == BallKind::Marble) ignite(bi, at);
+    if (bFire && a.kind == BallKind::Marble) ignite(ai, at);
+    if ((aFire || bFire) && vn < 0) emitSparks(at, n, 8);
+    return true;
 }
 
 void World::ignite(int marble, const Vec3& at) {
@@ -543,7 +673,8 @@ void World::emitSparks(const Vec3& at, const Vec3& normal, int count) {
         if (!p) return;
         p->kind = ParticleKind::Spark;
         p->position = at;
-        p->velocity = (normal + 0.6 * rng_.inUnitBall()) * rng_.uniform(1.0, 3.0);
+        const Vec3 spread = rng_.inUnitBall();
+        p->velocity = (normal + 0.6 * spread) * rng_.uniform(1.0, 3.0);
         p->maxLife = p->life = rng_.uniform(0.7, 1.3);
         p->size = 0.008;
     }
@@ -563,20 +694,25 @@ void World::emitAsh(const Ball& marble) {
 
 void World::updateParticles(double dt) {
     // Fire: 400/s per fireball, inside it and denser near its centre.
-    size_t fireball = 0;
     for (auto& b : balls_) {
         if (b.kind != BallKind::Fireball && b.kind != BallKind::Burning) continue;
-        if (fireAccumulator_.size() <= fireball) fireAccumulator_.push_back(0.0);
-        double& owed = fireAccumulator_[fireball++];
+        double& owed = b.fireOwed;
         owed += kFireRate * dt * (b.kind == BallKind::Burning ? 0.5 : 1.0);
         for (; owed >= 1.0; owed -= 1.0) {
             Particle* p = allocateParticle();
-            if (!p) break;
+            if (!p) {
+                owed = 0.0;  // the pool is full: drop them rather than owe a burst
+                break;
+            }
             const Vec3 dir = rng_.onUnitSphere();
             const double u = rng_.uniform();
             p->kind = ParticleKind::Fire;
             p->position = b.position + dir * (b.radius * u * u);  // u² packs them near the centre
-            p->velocity = b.velocity + Vec3(0.3 * rng_.uniform(-1, 1), rng_.uniform(0.4, 1.2), 0.3 * rng_.uniform(-1, 1));
+            Vec3 up;
+            up.x = 0.3 * rng_.uniform(-1, 1);
+            up.y = rng_.uniform(0.4, 1.2);
+            up.z = 0.3 * rng_.uniform(-1, 1);
+            p->velocity = b.velocity + up;
             p->maxLife = p->life = kFireLife;
             p->size = b.radius * 0.35;
         }
@@ -602,21 +738,26 @@ void World::updateParticles(double dt) {
 
 void World::spawnMarble(const Vec3& position, const Vec3& velocity, double radius) {
     const double l = 1.0 - radius;
-    balls_.push_back({glm::clamp(position, Vec3(-l), Vec3(l)), velocity, Vec3(0.0), radius, BallKind::Marble,
-                      Vec3(0.2 + 0.6 * rng_.uniform(), 0.2 + 0.6 * rng_.uniform(), 0.2 + 0.6 * rng_.uniform()), 0.0});
+    Vec3 color;
+    for (int k = 0; k < 3; ++k) color[k] = 0.2 + 0.6 * rng_.uniform();  // sequenced: deterministic
+    balls_.push_back({glm::clamp(position, Vec3(-l), Vec3(l)), velocity, Vec3(0.0), radius, BallKind::Marble, color});
     ++bodiesVersion_;
 }
 
 void World::spawnFireball(const Vec3& position, const Vec3& velocity, double radius) {
     const double l = 1.0 - radius;
     balls_.push_back({glm::clamp(position, Vec3(-l), Vec3(l)), velocity, Vec3(0.0), radius, BallKind::Fireball,
-                      Vec3(1.0, 0.5, 0.1), 0.0});
+                      Vec3(1.0, 0.5, 0.1)});
     ++bodiesVersion_;
 }
 
 void World::spawnRandom(BallKind kind) {
-    const Vec3 p(rng_.uniform(-0.7, 0.7), rng_.uniform(0.0, 0.6), rng_.uniform(-0.7, 0.7));
-    const Vec3 v = rng_.onUnitSphere() * rng_.uniform(1.0, 3.0);
+    Vec3 p;  // one draw per statement: argument evaluation order is unspecified
+    p.x = rng_.uniform(-0.7, 0.7);
+    p.y = rng_.uniform(0.0, 0.6);
+    p.z = rng_.uniform(-0.7, 0.7);
+    const Vec3 dir = rng_.onUnitSphere();
+    const Vec3 v = dir * rng_.uniform(1.0, 3.0);
     if (kind == BallKind::Fireball) spawnFireball(p, v);
     else spawnMarble(p, v);
 }
@@ -642,8 +783,9 @@ std::optional<RayHit> World::raycastTumblers(const Vec3& origin, const Vec3& dir
 DragMode World::beginDrag(const RayHit& hit) {
     drag_.tumbler = hit.tumbler;
     Tumbler& t = tumblers_[size_t(hit.tumbler)];
-    // SPEC §4.4: below the centre of mass (y < −1 + b) translates, above rotates.
-    drag_.mode = hit.point.y < -1.0 + shape_.b() ? DragMode::Translate : DragMode::Rotate;
+    // SPEC §4.4: a hit below the centre of mass translates, above rotates (the seed's
+    // centre of mass is O at y = −1 + b; accurate mode's sits ballast_h lower).
+    drag_.mode = hit.point.y < centreOfMass(hit.tumbler).y ? DragMode::Translate : DragMode::Rotate;
     drag_.planeY = hit.point.y;
     drag_.offset = hit.point - t.position;
     t.velocity = t.angularVelocity = Vec3(0.0);
@@ -700,7 +842,55 @@ uint64_t World::stateHash() const {
         h = fnv(h, &p.life, sizeof p.life);
     }
     h = fnv(h, &time_, sizeof time_);
+    const uint32_t rngProbe = Rng(rng_).next();  // the generator's position, not its internals
+    h = fnv(h, &rngProbe, sizeof rngProbe);
     return h;
+}
+
+double World::ballEnergy(int i) const {
+    const Ball& b = balls_[size_t(i)];
+    const double g = b.kind == BallKind::Fireball ? 0.0 : scene_.physics.gravity;
+    const double dt = scene_.physics.dt / std::max(1, scene_.physics.substeps);
+    return 0.5 * glm::dot(b.velocity, b.velocity) + g * b.position.y - 0.5 * g * dt * b.velocity.y;
+}
+
+void World::writeTumblerInstances(std::vector<TumblerInstance>& out) const {
+    out.resize(tumblers_.size());
+    for (size_t i = 0; i < tumblers_.size(); ++i) {
+        tumblers_[i].modelMatrix(out[i].model);
+        for (int k = 0; k < 3; ++k) out[i].color[k] = float(tumblers_[i].color[k]);
+        out[i].asleep = tumblers_[i].asleep ? 1u : 0u;
+    }
+}
+
+void World::writeBallInstances(std::vector<BallInstance>& out) const {
+    out.resize(balls_.size());
+    for (size_t i = 0; i < balls_.size(); ++i) {
+        const Ball& b = balls_[i];
+        const Vec3 albedo = b.albedo(), emissive = b.emissiveColor();
+        for (int k = 0; k < 3; ++k) {
+            out[i].position[k] = float(b.position[k]);
+            out[i].albedo[k] = float(albedo[k]);
+            out[i].emissive[k] = float(emissive[k]);
+        }
+        out[i].radius = float(b.radius);
+        out[i].kind = uint32_t(b.kind);
+        out[i].strength = float(b.emissiveStrength());
+    }
+}
+
+void World::writeParticleInstances(std::vector<ParticleInstance>& out) const {
+    out.resize(particles_.size());
+    for (size_t i = 0; i < particles_.size(); ++i) {
+        const Particle& p = particles_[i];
+        const Vec3 e = p.emission();
+        for (int k = 0; k < 3; ++k) {
+            out[i].position[k] = float(p.position[k]);
+            out[i].emission[k] = float(e[k]);
+        }
+        out[i].radius = float(p.radius());
+        out[i].kind = uint32_t(p.kind);
+    }
 }
 
 double World::maxQuaternionError() const {

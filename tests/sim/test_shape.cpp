@@ -88,6 +88,30 @@ TEST_CASE("round cone gradient is the central difference of the SDF outside", "[
     CHECK(worst < 1e-5);
 }
 
+TEST_CASE("round cone gradient is the central difference of the SDF inside too", "[sim][shape]") {
+    RoundCone s;
+    Rng rng(4);
+    double worst = 0;
+    int used = 0;
+    for (int i = 0; i < 20000; ++i) {
+        Vec3 p(rng.uniform(-0.2, 0.2), rng.uniform(-0.2, 0.4), rng.uniform(-0.2, 0.2));
+        if (s.sdf(p) > -1e-3) continue;
+        const double h = 1e-6;
+        Vec3 fd((s.sdf(p + Vec3(h, 0, 0)) - s.sdf(p - Vec3(h, 0, 0))) / (2 * h),
+                (s.sdf(p + Vec3(0, h, 0)) - s.sdf(p - Vec3(0, h, 0))) / (2 * h),
+                (s.sdf(p + Vec3(0, 0, h)) - s.sdf(p - Vec3(0, 0, h))) / (2 * h));
+        // Inside, the SDF has a medial axis (the cone's axis, and where the pieces meet
+        // inside): there the difference straddles two pieces and is not a unit vector.
+        // Away from it the gradient must match.
+        if (std::abs(glm::length(fd) - 1.0) > 1e-6) continue;
+        ++used;
+        worst = std::max(worst, glm::length(fd - s.gradient(p)));
+    }
+    INFO(used << " interior points used");
+    CHECK(used > 5000);
+    CHECK(worst < 1e-5);  // as outside: truncation ~1e-12, rounding ~1e-10
+}
+
 TEST_CASE("SDF and gradient stay finite on the axis and at the sphere centres", "[sim][shape]") {
     RoundCone s;
     for (double y = -0.25; y <= 0.45; y += 0.001) {
@@ -98,7 +122,16 @@ TEST_CASE("SDF and gradient stay finite on the axis and at the sphere centres", 
         CHECK(glm::length(g) == Approx(1.0).epsilon(1e-12));
     }
     CHECK(s.sdf(Vec3(0.0)) == Approx(-0.2).epsilon(1e-12));
+    CHECK(s.sdf(Vec3(0, s.upperCentre(), 0)) == Approx(-0.1).epsilon(1e-12));
     CHECK(std::isfinite(glm::length(s.gradient(Vec3(0, s.upperCentre(), 0)))));
+    CHECK(glm::length(s.gradient(Vec3(0.0))) == Approx(1.0));
+    // Radius profile: the three pieces meet continuously.
+    const double eps = 1e-12;
+    for (double y : {s.b() * std::sin(s.alpha()), s.upperCentre() + s.t() * std::sin(s.alpha())})
+        CHECK(s.radiusAt(y - eps) == Approx(s.radiusAt(y + eps)).margin(1e-9));
+    CHECK(s.radiusAt(0.0) == Approx(0.2));
+    CHECK(s.radiusAt(s.top()) == Approx(0.0).margin(1e-12));
+    CHECK(s.radiusAt(s.top() + 0.01) == 0.0);
 }
 
 TEST_CASE("the seed's threshold slip is fixed: 1 cm above the top reads +1 cm", "[sim][shape]") {

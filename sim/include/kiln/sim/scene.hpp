@@ -1,20 +1,44 @@
-// kiln/sim/scene.hpp — the scene file (scenes/cornell.json) as plain data, read by the
-// simulation, the renderer and the reference alike.
+// kiln/sim/scene.hpp — the scene file (scenes/cornell.json) as plain data. One parser
+// for everyone: the simulation, the renderer and the path-traced reference all read the
+// scene through this header (see also scenes/README.md).
+//
+// Format (all lengths in metres inside the box [-1,1]³, the floor is y = −1; colours
+// linear RGB in [0,1]; angles in radians unless the key says _deg):
 //
 //   {
-//     "box":   { "left": [r,g,b], "right": [r,g,b], "other": [r,g,b] },
-//     "lamp":  { "center": [0, 1.1, 0], "radius": 0.35, "color": [r,g,b], "intensity": 4 },
-//     "physics": { "dt": 0.004166, "substeps": 4, "gravity": 9.81, "friction": 0.005,
-//                  "wall_decay": 0.5, "tumbler_mode": "seed" | "accurate",
-//                  "tumbler_contact": "four_spheres" | "exact", "ballast_h": 0.05, "seed": 1 },
+//     "box": {                                   // the Cornell box's look
+//       "left": [r,g,b],  "right": [r,g,b],      // x = −1 wall (orange), x = +1 (sky blue)
+//       "other": [r,g,b],                        // back wall, ceiling (and floor tint)
+//       "floor_wood": { "light": [r,g,b], "dark": [r,g,b], "ring_frequency": 14 }
+//     },
+//     "lamp": { "center": [0, 1.1, 0], "radius": 0.35,   // hemisphere (dome reaches y = 0.75)
+//               "color": [r,g,b], "intensity": 4 },      // light position = center (outside)
+//     "physics": {
+//       "dt": 0.0041667,            // one frame (s), (0, 0.1]
+//       "substeps": 4,              // sub-steps per frame, 1..64
+//       "gravity": 9.81,            // m/s², [0, 100]
+//       "friction": 0.005,          // μ of the rocking damping (SPEC §4.1), [0, 10]
+//       "wall_decay": 0.5,          // tumbler velocity kept after hitting a wall, [0, 1]
+//       "tumbler_mode": "seed" | "accurate",         // restoring impulse | weighted base
+//       "tumbler_contact": "four_spheres" | "exact", // tumbler-vs-tumbler method
+//       "ballast_h": 0.05,          // accurate mode: centre of mass this far below O
+//       "seed": 1                   // random generator seed (integer ≥ 0)
+//     },
 //     "tumbler_shape": { "b": 0.2, "t": 0.1, "alpha_deg": 20, "mass": 1 },
-//     "tumblers":  [ { "position": [x, z], "tilt": [about_x, about_z], "color": [r,g,b] } ],
+//     "tumblers": [                               // required (may be empty)
+//       { "position": [x, z], "tilt": [about_x, about_z], "color": [r,g,b] } ],
 //     "marbles":   [ { "position": [x,y,z], "velocity": [x,y,z], "radius": 0.05, "color": [r,g,b] } ],
 //     "fireballs": [ { "position": [x,y,z], "velocity": [x,y,z], "radius": 0.06, "color": [r,g,b] } ]
 //   }
 //
-// Every key is optional except "tumblers"; missing ones take the defaults below. Unknown
-// keys are errors (a typo would otherwise be silently ignored), "note" excepted.
+// Every key is optional except "tumblers" and each entry's "position"; missing ones take
+// the defaults below. Unknown keys are errors (a typo would otherwise be silently
+// ignored); "note" and "$schema" are allowed anywhere. Checked beyond types and ranges:
+// t < b, every tumbler (both spheres, with its tilt) inside the box, tumblers not
+// overlapping each other, every ball inside the box.
+//
+// Errors carry the JSON path (`tumblers[2].position`, `physics.dt`, `marbles[0].radius`)
+// and what is wrong; a syntax error carries "line L, column C: ..." and an empty path.
 #pragma once
 
 #include <cstdint>
@@ -28,6 +52,7 @@ namespace kiln::sim {
 struct SceneError {
     std::string path;     // JSON path, e.g. "tumblers[2].position"; empty for syntax errors
     std::string message;  // what is wrong (for syntax errors: "line L, column C: ...")
+    // "FILE: PATH: MESSAGE" (or "FILE: MESSAGE" without a path): one line for a terminal.
     std::string toString(const std::string& file) const;
 };
 
@@ -37,6 +62,10 @@ enum class TumblerContact : uint8_t { FourSpheres, Exact };
 struct Scene {
     struct Box {
         glm::dvec3 left{0.95, 0.45, 0.1}, right{0.35, 0.65, 0.95}, other{0.85, 0.82, 0.78};
+        struct FloorWood {
+            glm::dvec3 light{0.72, 0.52, 0.32}, dark{0.45, 0.28, 0.15};
+            double ringFrequency = 14.0;  // growth rings per metre of radius
+        } floorWood;
     } box;
     struct Lamp {
         glm::dvec3 center{0.0, 1.1, 0.0};
@@ -73,7 +102,22 @@ struct Scene {
     std::vector<BallSpec> marbles, fireballs;
 };
 
-// Parses and validates; on failure returns false and fills `error`.
+// Either a scene or an error (never both).
+struct SceneResult {
+    Scene scene;       // valid when ok()
+    SceneError error;  // set when !ok()
+    bool valid = false;
+    bool ok() const { return valid; }
+    explicit operator bool() const { return valid; }
+};
+
+// Parses and validates scene text (tests, live editing).
+SceneResult parseSceneText(const std::string& text);
+// Reads and parses a file; an unreadable file gives path "" and "cannot read ...".
+SceneResult loadSceneFile(const std::string& path);
+
+// The same, bool-returning (kept for the host): on failure returns false and fills
+// `error` (for loadScene: one line "FILE: PATH: MESSAGE"); `out` is left untouched.
 bool parseScene(const std::string& text, Scene& out, SceneError& error);
 bool loadScene(const std::string& path, Scene& out, std::string& error);
 

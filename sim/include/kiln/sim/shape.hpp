@@ -2,6 +2,16 @@
 // sphere of radius b at the local origin and an upper sphere of radius t at
 // (0, y_t, 0), y_t = (b − t)/sin α), its exact signed distance and gradient, and its
 // mass properties in closed form (spherical caps + frustum) and by quadrature.
+//
+// SDF (SPEC §3.3, Quilez's sdRoundCone): with r = √(x²+z²), k = y·cos α − r·sin α:
+//   k < 0            → lower sphere   √(r² + y²) − b
+//   k > y_t·cos α    → upper sphere   √(r² + (y − y_t)²) − t     ([fix]: not y_t / tan α)
+//   otherwise        → side           y·sin α + r·cos α − b
+// It is exact inside and outside. The gradient is the outward normal of the nearest
+// piece; on the axis inside the side region (no unique normal) it returns +y.
+//
+// Also here: the exact separation of two round cones (tumbler vs tumbler), minimising
+// |P_A(s) − P_B(u)| − r_A(s) − r_B(u) over s, u ∈ [0, 1] (jointly convex).
 #pragma once
 
 #include <glm/glm.hpp>
@@ -43,8 +53,38 @@ public:
     // The same by Gauss–Legendre quadrature of radiusAt() (a cross-check).
     MassProperties integratedMassProperties(double mass, int intervalsPerPiece = 64) const;
 
+    // World-space versions for a body at `position` (the local origin O) with
+    // orientation `q`: the point goes to local space, the normal comes back rotated.
+    double sdfWorld(const Vec3& p, const Vec3& position, const Quat& q) const;
+    Vec3 gradientWorld(const Vec3& p, const Vec3& position, const Quat& q) const;
+
 private:
     double b_, t_, alpha_, s_, c_, yt_;
 };
+
+// Exact signed distance from x to the round cone with axis a0 → a1 and end radii r0, r1
+// (any orientation; equals min over u of |x − P(u)| − r(u), inside too).
+double roundConeDistance(const Vec3& x, const Vec3& a0, const Vec3& a1, double r0, double r1);
+
+// Exact separation of two round cones A (a0→a1, radii ra0, ra1) and B: the minimum
+// over s, u ∈ [0,1] of |P_A(s) − P_B(u)| − r_A(s) − r_B(u) (negative: they overlap by
+// that much along `normal`). The function is jointly convex, so the nested 1-D
+// minimisation (golden section on s, the closed-form round-cone distance for u) finds
+// the global minimum.
+struct ConeSeparation {
+    double distance = 0;
+    double s = 0, u = 0;          // parameters on A's and B's axes
+    Vec3 onA{0.0}, onB{0.0};      // the axis points P_A(s), P_B(u)
+    Vec3 normal{1, 0, 0};         // unit, from A towards B (a fallback when the axes meet)
+    Vec3 witnessA{0.0}, witnessB{0.0};  // surface points P_A + r_A·n and P_B − r_B·n
+};
+ConeSeparation roundConeSeparation(const Vec3& a0, const Vec3& a1, double ra0, double ra1, const Vec3& b0,
+                                   const Vec3& b1, double rb0, double rb1);
+
+// The seed's approximation (four end spheres, each against the other body's exact
+// SDF): min of SDF_B(a0) − ra0, SDF_B(a1) − ra1, SDF_A(b0) − rb0, SDF_A(b1) − rb1.
+// Never below the exact separation (each end sphere is a subset of its body).
+double fourSphereSeparation(const Vec3& a0, const Vec3& a1, double ra0, double ra1, const Vec3& b0,
+                            const Vec3& b1, double rb0, double rb1);
 
 }  // namespace kiln::sim

@@ -2,6 +2,25 @@
 // of the Cornell box [-1,1]³, marbles and fireballs bouncing without loss, fire and
 // particles, and mouse picking. Plain data in arrays and a fixed-Δt step; no OpenGL,
 // no hidden globals: same scene, seed and inputs ⇒ bit-identical state (stateHash).
+//
+// Use:
+//   kiln::sim::SceneResult r = kiln::sim::loadSceneFile("scenes/cornell.json");
+//   if (!r) { std::cerr << r.error.toString("scenes/cornell.json") << "\n"; return 1; }
+//   kiln::sim::World world(r.scene);
+//   each frame (unless paused): world.step();          // dt = scene.physics.dt
+//   if (world.bodiesVersion() != seen) upload tumblers()/balls() (or the *Instances()
+//   float arrays below); likewise particlesVersion() for particles().
+//
+// Model (SPEC §4): a tumbler's lower-sphere centre O stays at y = −1 + b and it rolls
+// without slipping; "seed" mode puts the centre of mass at O and adds the seed's
+// restoring impulse, "accurate" mode puts it ballast_h below O so gravity rights it.
+// Balls (marbles with gravity, fireballs without) reflect without loss off the box,
+// the lamp dome, tumblers (momentum-conserving impulse) and each other (elastic).
+// Units: metres, seconds, kilograms (a tumbler's mass is scene.tumblerShape.mass).
+//
+// Limits: tumblers never leave the floor (no jumping); ball-ball and ball-tumbler
+// contacts are resolved pairwise once per sub-step (no simultaneous solve), so dense
+// piles jitter; particles are capped at World::kMaxParticles (new ones are dropped).
 #pragma once
 
 #include <cstdint>
@@ -48,13 +67,22 @@ struct Tumbler {
 
 enum class BallKind : uint8_t { Marble, Fireball, Burning };
 
+// Seconds a burning marble glows before it crumbles to ash (removed, ash particles).
+inline constexpr double kBurnDuration = 1.2;
+
 struct Ball {
     Vec3 position{0.0}, velocity{0.0}, angularVelocity{0.0};
     double radius = 0.05;
     BallKind kind = BallKind::Marble;
     Vec3 color{0.8};
     double burnTime = 0.0;  // seconds burning (BallKind::Burning)
+    double fireOwed = 0.0;  // fractional fire particles owed (fireballs, burning marbles)
     double mass() const { return radius * radius * radius * 8000.0; }  // ∝ volume, glass-ish scale
+    // What the renderer draws: the diffuse colour (a burning marble darkens towards ash)
+    // and the emission, colour × strength (fireballs and burning marbles glow).
+    Vec3 albedo() const;
+    Vec3 emissiveColor() const;
+    double emissiveStrength() const;
 };
 
 enum class ParticleKind : uint8_t { Fire, Spark, Ash };
@@ -68,6 +96,35 @@ struct Particle {
     double radius() const;
     Vec3 emission() const;
 };
+
+// GPU-ready instance records (float, tightly packed, 16-byte multiples) written by
+// World::write*Instances; upload the vector's data() as an instance buffer.
+struct TumblerInstance {
+    float model[16];      // column-major model matrix (local → world)
+    float color[3];
+    uint32_t asleep;      // 1 when the tumbler sleeps
+};
+struct BallInstance {
+    float position[3];
+    float radius;
+    float albedo[3];
+    uint32_t kind;        // BallKind
+    float emissive[3];    // colour, multiply by strength
+    float strength;
+};
+struct ParticleInstance {
+    float position[3];
+    float radius;
+    float emission[3];    // emitted radiance (already scaled)
+    uint32_t kind;        // ParticleKind
+};
+static_assert(sizeof(TumblerInstance) == 80 && sizeof(BallInstance) == 48 && sizeof(ParticleInstance) == 32);
+
+// Solves K·j = Δv for a symmetric positive semi-definite 3×3 K (an effective-mass
+// matrix, K = (1/m)𝟙 − [r]×I⁻¹[r]×). When K is singular or nearly so (relative to its
+// scale) it returns the minimum-norm least-squares solution (pseudo-inverse, eigenvalues
+// below 1e-9·λ_max dropped): finite for every finite input; K = 0 gives j = 0.
+Vec3 solveImpulse(const Mat3& K, const Vec3& dv);
 
 struct RayHit {
     int tumbler = -1;
@@ -100,6 +157,14 @@ public:
     const std::vector<Ball>& balls() const { return balls_; }
     const std::vector<Particle>& particles() const { return particles_; }
 
+    // Contiguous float records for instanced drawing (cleared, then filled).
+    void writeTumblerInstances(std::vector<TumblerInstance>& out) const;
+    void writeBallInstances(std::vector<BallInstance>& out) const;
+    void writeParticleInstances(std::vector<ParticleInstance>& out) const;
+
+    // The particle pool's size: particles_ never grows beyond it (no reallocation).
+    static constexpr size_t kMaxParticles = 4096;
+
     // Bumped on each step in which a body moved / the particle set changed; a world
     // whose bodies all sleep (or that is not stepped) keeps them.
     uint64_t bodiesVersion() const { return bodiesVersion_; }
@@ -107,7 +172,8 @@ public:
 
     void spawnMarble(const Vec3& position, const Vec3& velocity, double radius = 0.05);
     void spawnFireball(const Vec3& position, const Vec3& velocity, double radius = 0.06);
-    // Spawns at a random free spot with a random velocity (keyboard shortcuts).
+    // Spawns at a random spot (x, z ∈ [−0.7, 0.7], y ∈ [0, 0.6]) with a random velocity
+    // of 1–3 m/s, drawn from the world's seeded generator (keyboard shortcuts).
     void spawnRandom(BallKind kind);
 
     // Signed distance from a world point to tumbler i, and the outward normal there.
@@ -128,6 +194,12 @@ public:
     // Resolves ball `ball` against tumbler `tumbler` if they overlap: pushes the ball
     // out and exchanges an elastic impulse (no floor involved). True on contact.
     bool resolveBallTumblerContact(int ball, int tumbler);
+    // Resolves two balls if they overlap: separation weighted by mass, elastic impulse
+    // (momentum and kinetic energy kept); a fireball touching a marble ignites it.
+    bool resolveBallBallContact(int a, int b);
+    // Resolves tumblers a and b with the scene's method; returns the separation it saw
+    // (negative: overlap) or +inf when they are too far apart to test.
+    double resolveTumblerPair(int a, int b);
     // Applies impulse j at world point p to tumbler i (no constraints).
     void applyImpulse(int i, const Vec3& p, const Vec3& j);
     // Velocity of the material point of tumbler i at world point p.
@@ -140,6 +212,12 @@ public:
     // FNV-1a over the raw state (bodies, balls, particles, RNG, time).
     uint64_t stateHash() const;
 
+    // A ball's modified mechanical energy per unit mass in free flight,
+    // E′ = ½|v|² + g·y − ½·g·Δt·v_y with Δt the sub-step (gravity-free balls: ½|v|²).
+    // Semi-implicit Euler keeps it exactly between bounces, and the time-symmetric
+    // wall bounce keeps it exactly across them (PHYSICS.md).
+    double ballEnergy(int ball) const;
+
     // Diagnostics for tests and `kiln-sim run`.
     double maxQuaternionError() const;  // max | |q| − 1 |
     bool allFinite() const;
@@ -150,10 +228,9 @@ private:
     void stepTumbler(int i, double dt);
     void collideTumblerWalls(int i);
     void collideTumblerFloor(int i);
-    void collideTumblerPair(int a, int b);
     void stepBall(Ball& ball, double dt);
     void collideBallTumblers(int ball);
-    void collideBallPair(int a, int b);
+    void collideBallPairs();
     void collideBallLamp(Ball& ball);
     void ignite(int marble, const Vec3& at);
     void updateParticles(double dt);
@@ -175,7 +252,8 @@ private:
     uint64_t steps_ = 0;
     uint64_t bodiesVersion_ = 0, particlesVersion_ = 0;
     bool bodiesMoved_ = false, particlesChanged_ = false;
-    std::vector<double> fireAccumulator_;  // fractional particles owed per fireball
+    std::vector<int> gridCells_, gridStart_, gridCursor_, gridOrder_;  // broad phase scratch (ball pairs)
+    std::vector<Vec3> ballsBefore_;  // ball positions at the start of the sub-step (swept tests)
 
     struct Drag {
         int tumbler = -1;
@@ -184,15 +262,5 @@ private:
         Vec3 offset{0.0};  // hit point − O at the start of a translate drag
     } drag_;
 };
-
-// Exact separation of two round cones given by their axis end points and radii
-// (negative when they overlap), with the closest points on their axes.
-struct ConeSeparation {
-    double distance;
-    double s, u;  // parameters on A's and B's axes
-    Vec3 onA, onB;  // axis points
-};
-ConeSeparation roundConeSeparation(const Vec3& a0, const Vec3& a1, double ra0, double ra1, const Vec3& b0,
-                                   const Vec3& b1, double rb0, double rb1);
 
 }  // namespace kiln::sim
