@@ -1,5 +1,7 @@
-// composite — the final image: direct light from the lamp on the G-buffer, plus
-// emission and (when bound) indirect light and bloom; tonemap and gamma.
+// composite — the final image: direct light from the lamp on the G-buffer (5×5 PCF
+// shadows from `shadow_map`), plus albedo × indirect irradiance (cone_trace), emission
+// and bloom; tonemap and gamma. Bloom is computed before this pass from the G-buffer's
+// emitted radiance (see passes/bloom), so no separate "lighting" pass is needed.
 #include <kiln/pass.hpp>
 
 namespace {
@@ -23,6 +25,7 @@ public:
             .param(enumParam("tonemap", "aces", {"aces", "reinhard", "clamp"}))
             .param(floatParam("gamma", 2.2f, 1.0, 3.0))
             .param(intChoiceParam("pcf", 5, {1, 3, 5, 7, 9}, "shadow filter kernel side: 5 = the seed's 5x5, 1 = hard"))
+            .param(floatParam("indirect_strength", 1.0f, 0.0, 8.0, "scales the bound indirect irradiance (1 = physical)"))
             .param(floatParam("shadow_bias", 0.0005f, 0.0, 0.05, "depth bias of the shadow test"))
             .shader("composite/composite.frag");
         d.reads = kSceneLight | kSceneCamera;
@@ -43,6 +46,7 @@ public:
         glUniform1i(glGetUniformLocation(program, "u_tonemap"), tonemap == "aces" ? 0 : tonemap == "reinhard" ? 1 : 2);
         glUniform1i(glGetUniformLocation(program, "u_pcf"), ctx.getInt("pcf"));
         glUniform1f(glGetUniformLocation(program, "u_shadowBias"), ctx.getFloat("shadow_bias"));
+        glUniform1f(glGetUniformLocation(program, "u_indirectStrength"), ctx.getFloat("indirect_strength"));
         ctx.drawFullscreenTriangle();
     }
 };

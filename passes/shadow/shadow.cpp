@@ -30,6 +30,13 @@ public:
             ctx.nothingToDo("no shadow caster moved");
             return;
         }
+        // No caster at all: clear the map once (everything lit), then there is nothing
+        // to draw until one appears.
+        const bool empty = scene.count(kiln::kDrawTumblers) + scene.count(kiln::kDrawMarbles) == 0;
+        if (empty && clearedEmpty_ && ctx.output("depth").width == int(lastKey_[3])) {
+            ctx.nothingToDo("no casters");
+            return;
+        }
         GLuint program = ctx.program({.stages = {"shadow/shadow.vert", "shadow/shadow.frag"}});
         if (!program || !ctx.framebuffer({}, "depth")) return;
         const float one = 1.0f;
@@ -39,7 +46,8 @@ public:
         glEnable(GL_POLYGON_OFFSET_FILL);
         glPolygonOffset(ctx.getFloat("slope_bias"), 4.0f);
         glUseProgram(program);
-        ctx.drawScene({.categories = kiln::kDrawShadowCasters, .lod = kiln::Lod::High});
+        clearedEmpty_ = empty;
+        if (!empty) ctx.drawScene({.categories = kiln::kDrawShadowCasters, .lod = kiln::Lod::High});
         glDisable(GL_POLYGON_OFFSET_FILL);
         std::copy(key, key + 4, lastKey_);
         ran_ = true;
@@ -49,6 +57,7 @@ private:
     // A cache key only: losing it on a module reload just re-renders the map once.
     uint64_t lastKey_[4] = {};
     bool ran_ = false;
+    bool clearedEmpty_ = false;  // the map holds the cleared "no casters" state
 };
 
 }  // namespace

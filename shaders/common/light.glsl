@@ -32,3 +32,40 @@ vec4 lightSpace(vec3 world) {
     float inside = (c.w > 0.0 && all(lessThan(abs(ndc), vec3(1.0)))) ? 1.0 : 0.0;
     return vec4(ndc * 0.5 + 0.5, inside);
 }
+
+// Light arriving from the lamp at a surface point p with unit normal n, before
+// visibility: u_lightColor · cos θ · the seed's "directional" falloff (the lamp is a
+// hemisphere opening downwards, so light leaving it at a grazing angle to −y is
+// dimmer and the wall tops get shade). Diffuse outgoing radiance = albedo/π · this ·
+// visibility. Shared by composite (with PCF) and voxelize (hard shadow), so the
+// voxels and the screen agree on the direct light.
+vec3 lampLight(vec3 p, vec3 n) {
+    vec3 l = normalize(u_lightPos.xyz - p);
+    float cosTheta = max(dot(n, l), 0.0);
+    float directional = smoothstep(0.0, 1.0, clamp(dot(-l, vec3(0.0, -1.0, 0.0)), 0.0, 1.0));
+    return u_lightColor.rgb * cosTheta * directional;
+}
+
+// Fraction of the lamp that sees p through a shadow map of the casters: a k×k
+// percentage-closer filter (k = 1: one hard test). Outside the light's frustum: lit.
+// The four corner taps go first: when they agree (far from any shadow edge, most of
+// the picture) the answer is theirs and the other k²−4 taps are skipped.
+float shadowVisibility(sampler2D shadowMap, vec3 p, int k, float bias) {
+    vec4 ls = lightSpace(p);
+    if (ls.w == 0.0) return 1.0;
+    vec2 texel = 1.0 / vec2(textureSize(shadowMap, 0));
+    int r = k / 2;
+    float z = ls.z - bias;
+    if (r > 0) {
+        float c = (z <= texture(shadowMap, ls.xy + vec2(-r, -r) * texel).r ? 1.0 : 0.0)
+                + (z <= texture(shadowMap, ls.xy + vec2(r, -r) * texel).r ? 1.0 : 0.0)
+                + (z <= texture(shadowMap, ls.xy + vec2(-r, r) * texel).r ? 1.0 : 0.0)
+                + (z <= texture(shadowMap, ls.xy + vec2(r, r) * texel).r ? 1.0 : 0.0);
+        if (c == 0.0 || c == 4.0) return c * 0.25;
+    }
+    float lit = 0.0;
+    for (int y = -r; y <= r; ++y)
+        for (int x = -r; x <= r; ++x)
+            lit += (z <= texture(shadowMap, ls.xy + vec2(x, y) * texel).r) ? 1.0 : 0.0;
+    return lit / float((2 * r + 1) * (2 * r + 1));
+}

@@ -23,20 +23,13 @@ uniform float u_gamma;
 uniform int u_tonemap;
 uniform int u_pcf;
 uniform float u_shadowBias;
+uniform float u_indirectStrength;
 
 // Fraction of the lamp that sees p: a k×k percentage-closer filter over the shadow
 // map (k = u_pcf; 1 is a hard shadow). No map bound: everything is lit.
 float lightVisibility(vec3 p) {
 #if KILN_HAS_SHADOW_MAP
-    vec4 ls = lightSpace(p);
-    if (ls.w == 0.0) return 1.0;
-    vec2 texel = 1.0 / vec2(textureSize(u_shadowMap, 0));
-    int r = u_pcf / 2;
-    float lit = 0.0;
-    for (int y = -r; y <= r; ++y)
-        for (int x = -r; x <= r; ++x)
-            lit += (ls.z - u_shadowBias <= texture(u_shadowMap, ls.xy + vec2(x, y) * texel).r) ? 1.0 : 0.0;
-    return lit / float((2 * r + 1) * (2 * r + 1));
+    return shadowVisibility(u_shadowMap, p, u_pcf, u_shadowBias);
 #else
     return 1.0;
 #endif
@@ -63,15 +56,10 @@ void main() {
         vec3 albedo = texture(u_albedo, v_uv).rgb;
         vec3 p = worldPosition(v_uv, texture(u_depth, v_uv).r);
         vec3 n = normalize(n4.xyz);
-        vec3 toLight = u_lightPos.xyz - p;
-        vec3 l = normalize(toLight);
-        float cosTheta = max(dot(n, l), 0.0);
-        // The lamp is a hemisphere opening downwards: light leaving it at a grazing
-        // angle to −y is dimmer. cos of the angle between −l and −y, shaped.
-        float directional = smoothstep(0.0, 1.0, clamp(dot(-l, vec3(0, -1, 0)), 0.0, 1.0));
+        float cosTheta = max(dot(n, normalize(u_lightPos.xyz - p)), 0.0);
         float visible = cosTheta > 0.0 ? lightVisibility(p + n * 0.004) : 0.0;
-        vec3 direct = albedo / 3.14159265 * u_lightColor.rgb * cosTheta * directional * visible;
-        vec3 indirect = albedo * texture(u_indirect, v_uv).rgb;
+        vec3 direct = albedo / 3.14159265 * lampLight(p, n) * visible;
+        vec3 indirect = albedo * u_indirectStrength * texture(u_indirect, v_uv).rgb;
 #if KILN_HAS_INDIRECT == 0
         indirect = albedo * u_ambient;
 #endif

@@ -1,0 +1,102 @@
+// voxel_mip — mip chains of the voxel radiance (SPEC §6.4), compute shaders in 4³
+// workgroups, one dispatch per level.
+//
+// Outputs (both res³ cubes with a full mip chain; colours premultiplied by opacity):
+//   iso    level 0 = a copy of the input, level k = the mean of its 2×2×2 children
+//          (colour and opacity). Always built: it is cheap (1/7 of the voxels) and it
+//          is level 0 of the anisotropic lookups and the voxel_view's volume.
+//   aniso  (mode = aniso) six directional chains, Crassin et al. 2011: the value seen
+//          looking along direction D through a parent = the mean over the 4 child
+//          pairs along D of the front-to-back composite
+//              c = c_front + (1 − a_front)·c_back,  a = a_front + (1 − a_front)·a_back,
+//          front = the child met first travelling along D. They are stored as OCTANTS
+//          of one res³ atlas: atlas level k holds directional level k+1 (res/2^(k+1)
+//          per side), direction i ∈ {+x,−x,+y,−y,+z,−z} in the octant
+//          (i&1, (i>>1)&1, i>>2). A cone with direction d takes three of them, chosen
+//          by sign arithmetic (x: (d.x<0, 0, 0), y: (d.y<0, 1, 0), z: (d.z<0, 0, 1)),
+//          weighted by d² — three fetches from one sampler, no branch (see
+//          PERFORMANCE.md: six samplers behind a ?: cost ~7 fetches on llvmpipe).
+//          The sampler must clamp coordinates half a texel inside the octant
+//          (shaders/cone_trace/voxels.glsl does).
+// In iso mode the aniso atlas is cleared to zero once and left alone.
+#include <kiln/pass.hpp>
+
+namespace {
+
+class VoxelMip final : public kiln::Pass {
+public:
+    kiln::PassDeclaration declare() const override {
+        using namespace kiln;
+        PassDeclaration d;
+        const auto cube = SizeRule::fromParam("resolution");
+        d.input({.name = "radiance", .kind = TextureKind::Color3D, .doc = "voxelize.radiance"})
+            .output({.name = "iso", .kind = TextureKind::Color3D, .format = Format::RGBA16F, .size = cube,
+                     .mips = kFullMipChain, .doc = "isotropic chain; level 0 = the input"})
+            .output({.name = "aniso", .kind = TextureKind::Color3D, .format = Format::RGBA16F, .size = cube,
+                     .mips = kFullMipChain,
+                     .doc = "six directional chains as octants; atlas level k = directional level k+1"})
+            .param(enumParam("mode", "aniso", {"iso", "aniso"}, "build the anisotropic chains too"))
+            .param(intChoiceParam("resolution", 64, {8, 16, 32, 64, 128}, "must match voxelize's resolution"))
+            .shader("voxel_mip/iso.comp")
+            .shader("voxel_mip/aniso.comp");
+        return d;
+    }
+
+    void execute(kiln::PassContext& ctx) override {
+        GLuint iso = ctx.program({.stages = {"voxel_mip/iso.comp"}});
+        GLuint aniso = ctx.program({.stages = {"voxel_mip/aniso.comp"}});
+        if (!iso || !aniso) return;
+        const kiln::TextureRef& in = ctx.input("radiance");
+        const kiln::TextureRef& chain = ctx.output("iso");
+        const kiln::TextureRef& atlas = ctx.output("aniso");
+        const int res = chain.width;
+        if (in.width != res || in.height != res || in.depth != res) {
+            ctx.fail("radiance input is " + std::to_string(in.width) + "^3 but resolution is " + std::to_string(res) +
+                     ": set the same resolution on voxelize and voxel_mip");
+            return;
+        }
+        glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+        glCopyImageSubData(in.id, GL_TEXTURE_3D, 0, 0, 0, 0, chain.id, GL_TEXTURE_3D, 0, 0, 0, 0, res, res, res);
+
+        auto groups = [](int n) { return GLuint((n + 3) / 4); };
+        glUseProgram(iso);
+        for (int level = 1; level < chain.levels; ++level) {
+            const int n = std::max(1, res >> level);
+            glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+            glBindImageTexture(0, chain.id, level - 1, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA16F);
+            glBindImageTexture(1, chain.id, level, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA16F);
+            glDispatchCompute(groups(n), groups(n), groups(n));
+        }
+
+        if (ctx.getEnum("mode") == "aniso") {
+            glUseProgram(aniso);
+            // Directional level L (1 … log2 res) lives in atlas level L−1, octant side res>>L.
+            for (int L = 1; (res >> L) >= 1; ++L) {
+                const int n = res >> L;
+                glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+                if (L == 1)
+                    glBindImageTexture(0, chain.id, 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA16F);
+                else
+                    glBindImageTexture(0, atlas.id, L - 2, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA16F);
+                glBindImageTexture(1, atlas.id, L - 1, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA16F);
+                glUniform1i(glGetUniformLocation(aniso, "u_fromBase"), L == 1 ? 1 : 0);
+                glUniform1i(glGetUniformLocation(aniso, "u_size"), n);
+                glDispatchCompute(groups(n), groups(n), groups(n));
+            }
+            atlasCleared_ = false;
+        } else if (!atlasCleared_) {
+            for (int l = 0; l < atlas.levels; ++l) glClearTexImage(atlas.id, l, GL_RGBA, GL_FLOAT, nullptr);
+            atlasCleared_ = true;
+        }
+        glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+        glBindImageTexture(0, 0, 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA16F);
+        glBindImageTexture(1, 0, 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA16F);
+    }
+
+private:
+    bool atlasCleared_ = false;  // a cache flag only
+};
+
+}  // namespace
+
+KILN_PASS_MODULE(voxel_mip, VoxelMip)

@@ -1,0 +1,53 @@
+#version 450 core
+// Anisotropic mip level (Crassin et al. 2011), all six directions of one parent voxel
+// per invocation. Direction i ∈ {+x,−x,+y,−y,+z,−z}; its chain lives in the octant
+// (i&1, (i>>1)&1, i>>2) of the atlas (passes/voxel_mip/voxel_mip.cpp). The value for
+// direction D = the mean over the 4 child pairs along D's axis of the front-to-back
+// composite (front = the child met first travelling along D).
+layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
+layout(rgba16f, binding = 0) uniform readonly image3D u_src;   // the iso level 0, or the previous atlas level
+layout(rgba16f, binding = 1) uniform writeonly image3D u_dst;  // atlas level (octant side u_size)
+
+uniform int u_fromBase;  // 1: the source is the isotropic base (the same for every direction)
+uniform int u_size;      // parent voxels per side at this level
+
+ivec3 octant(int i) { return ivec3(i & 1, (i >> 1) & 1, i >> 2); }
+
+vec4 over(vec4 front, vec4 back) { return front + (1.0 - front.a) * back; }
+
+// Children c<xyz> named by their offset bits. Pairs along x: (c000,c100), (c010,c110),
+// (c001,c101), (c011,c111); likewise for y and z. Written out (no arrays, no dynamic
+// indexing), which llvmpipe compiles to straight vector code.
+#define LOAD8(src, b)                                                          \
+    vec4 c000 = imageLoad(src, b), c100 = imageLoad(src, b + ivec3(1, 0, 0)), \
+         c010 = imageLoad(src, b + ivec3(0, 1, 0)), c110 = imageLoad(src, b + ivec3(1, 1, 0)), \
+         c001 = imageLoad(src, b + ivec3(0, 0, 1)), c101 = imageLoad(src, b + ivec3(1, 0, 1)), \
+         c011 = imageLoad(src, b + ivec3(0, 1, 1)), c111 = imageLoad(src, b + ivec3(1, 1, 1))
+
+void storeAll(ivec3 v, int first, int last, vec4 c000, vec4 c100, vec4 c010, vec4 c110, vec4 c001, vec4 c101,
+              vec4 c011, vec4 c111) {
+    for (int i = first; i <= last; ++i) {
+        vec4 r;
+        if (i == 0) r = over(c000, c100) + over(c010, c110) + over(c001, c101) + over(c011, c111);
+        else if (i == 1) r = over(c100, c000) + over(c110, c010) + over(c101, c001) + over(c111, c011);
+        else if (i == 2) r = over(c000, c010) + over(c100, c110) + over(c001, c011) + over(c101, c111);
+        else if (i == 3) r = over(c010, c000) + over(c110, c100) + over(c011, c001) + over(c111, c101);
+        else if (i == 4) r = over(c000, c001) + over(c100, c101) + over(c010, c011) + over(c110, c111);
+        else r = over(c001, c000) + over(c101, c100) + over(c011, c010) + over(c111, c110);
+        imageStore(u_dst, v + octant(i) * u_size, r * 0.25);
+    }
+}
+
+void main() {
+    ivec3 v = ivec3(gl_GlobalInvocationID);
+    if (any(greaterThanEqual(v, ivec3(u_size)))) return;
+    if (u_fromBase == 1) {
+        LOAD8(u_src, 2 * v);
+        storeAll(v, 0, 5, c000, c100, c010, c110, c001, c101, c011, c111);
+    } else {
+        for (int i = 0; i < 6; ++i) {
+            LOAD8(u_src, 2 * v + octant(i) * (2 * u_size));
+            storeAll(v, i, i, c000, c100, c010, c110, c001, c101, c011, c111);
+        }
+    }
+}

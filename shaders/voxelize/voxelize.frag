@@ -1,0 +1,62 @@
+#version 450 core
+// Voxelization, stage 3: light the fragment (direct light with a hard shadow, plus
+// emission) and add it to every voxel its depth spans inside this pixel column.
+// Combination rule: exact average via atomic adds of fixed-point sums and a count
+// (passes/voxelize/voxelize.cpp explains why).
+#include "common/frame.glsl"
+#include "common/instances.glsl"
+#include "common/light.glsl"
+#include "common/wood.glsl"
+
+in vec3 v_world;
+in vec3 v_normal;
+flat in uint v_instance;
+flat in int v_axis;
+flat in vec4 v_aabb;
+flat in vec2 v_depthRange;
+
+layout(binding = 0) uniform sampler2D u_shadowMap;
+layout(r32ui, binding = 0) uniform coherent uimage3D u_sumR;
+layout(r32ui, binding = 1) uniform coherent uimage3D u_sumG;
+layout(r32ui, binding = 2) uniform coherent uimage3D u_sumB;
+layout(r32ui, binding = 3) uniform coherent uimage3D u_count;
+
+uniform int u_res;
+uniform float u_shadowBias;
+uniform float u_emissionScale;  // 1, or lamp_emission while drawing the lamp
+
+const float kFixedScale = 512.0;   // keep in sync with resolve.comp
+const float kMaxRadiance = 2048.0;
+
+void main() {
+    vec2 px = gl_FragCoord.xy;
+    if (px.x < v_aabb.x || px.y < v_aabb.y || px.x > v_aabb.z || px.y > v_aabb.w) discard;
+
+    KilnInstance inst = kiln_instances[v_instance];
+    vec3 albedo = inst.albedo.rgb;
+    if (inst.albedo.a > 0.5) albedo = woodGrain(v_world, albedo);
+    vec3 n = normalize(v_normal);
+    float vis = 1.0;
+#if KILN_HAS_SHADOW_MAP
+    vis = shadowVisibility(u_shadowMap, v_world + n * (2.0 / float(u_res)), 1, u_shadowBias);
+#endif
+    vec3 radiance = albedo / 3.14159265 * lampLight(v_world, n) * vis + inst.emissive.rgb * u_emissionScale;
+    uvec3 fixedRgb = uvec3(clamp(radiance, 0.0, kMaxRadiance) * kFixedScale + 0.5);
+
+    // Depth along the projection axis at this pixel, and how much it varies across it.
+    float depth = v_axis == 0 ? v_world.x : v_axis == 1 ? v_world.y : v_world.z;
+    float span = 0.5 * (abs(dFdx(depth)) + abs(dFdy(depth)));
+    float zLo = clamp(depth - span, v_depthRange.x, v_depthRange.y);
+    float zHi = clamp(depth + span, v_depthRange.x, v_depthRange.y);
+    int k0 = clamp(int(floor((zLo * 0.5 + 0.5) * float(u_res))), 0, u_res - 1);
+    int k1 = clamp(int(floor((zHi * 0.5 + 0.5) * float(u_res))), 0, u_res - 1);
+    ivec2 ij = clamp(ivec2(px), ivec2(0), ivec2(u_res - 1));
+    for (int k = k0; k <= min(k1, k0 + 2); ++k) {
+        // Back from (2D, depth) to (x, y, z): the inverse of the geometry shader's swizzle.
+        ivec3 v = v_axis == 0 ? ivec3(k, ij.x, ij.y) : v_axis == 1 ? ivec3(ij.y, k, ij.x) : ivec3(ij, k);
+        imageAtomicAdd(u_sumR, v, fixedRgb.r);
+        imageAtomicAdd(u_sumG, v, fixedRgb.g);
+        imageAtomicAdd(u_sumB, v, fixedRgb.b);
+        imageAtomicAdd(u_count, v, 1u);
+    }
+}
