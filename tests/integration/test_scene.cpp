@@ -31,12 +31,8 @@ struct Rig {
     app::App app;
     explicit Rig(const std::string& scene = {}, int size = 160) {
         REQUIRE(test::ensureHeadlessContext());
-        app::Options o;
-        app::applyDefaults(o);
+        app::Options o = test::pausedHeadlessOptions(size);
         if (!scene.empty()) o.scene = scene;
-        o.headless = true;
-        o.width = o.height = size;
-        o.paused = true;
         o.seed = 1;
         std::string error;
         REQUIRE(app.init(o, error));
