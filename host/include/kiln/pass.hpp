@@ -68,7 +68,9 @@
 //   are bound as "common/frame.glsl" expects. The host wraps each pass in a KHR_debug
 //   group and times it (GPU timer query + CPU clock).
 //
-// RULES THAT KEEP RELOADING SAFE (see LIVE_EDITING in the README)
+// RULES THAT KEEP RELOADING SAFE (see "Live editing" in the README)
+//   Set every uniform in each execute(): a shader edit swaps in a new program and no
+//   uniform value is carried over (so nothing needs restoring by reflection).
 //   No state in statics (a reload loses it); no thread_local with destructors; leave
 //   GL bindings as you like, the host resets the ones it relies on. Modules are built
 //   with -fvisibility=hidden -fno-gnu-unique by kiln_add_pass.
