@@ -47,24 +47,12 @@ void World::sync(SceneRenderer& scene, uint64_t versions[6], int highlighted) {
             bodies.push_back(b);
         }
         for (const auto& ball : sim_.balls()) {
+            // The sim owns the look of a ball (burning marbles darken towards ash).
             BodyInstance b;
+            b.category = ball.kind == sim::BallKind::Fireball ? kDrawFireballs : kDrawMarbles;
             b.model = glm::scale(glm::translate(glm::mat4(1.0f), glm::vec3(ball.position)), glm::vec3(float(ball.radius)));
-            b.albedo = glm::vec3(ball.color);
-            switch (ball.kind) {
-                case sim::BallKind::Marble: b.category = kDrawMarbles; break;
-                case sim::BallKind::Fireball:
-                    b.category = kDrawFireballs;
-                    b.emissive = glm::vec3(ball.color) * 6.0f;
-                    break;
-                case sim::BallKind::Burning: {
-                    // Burning: the marble glows and darkens towards ash as it burns.
-                    const float f = float(std::min(1.0, ball.burnTime / 1.2));
-                    b.category = kDrawMarbles;
-                    b.albedo *= 1.0f - f;
-                    b.emissive = glm::vec3(3.0f, 1.2f, 0.3f) * (1.0f - f * 0.7f);
-                    break;
-                }
-            }
+            b.albedo = glm::vec3(ball.albedo());
+            b.emissive = glm::vec3(ball.emissiveColor() * ball.emissiveStrength());
             bodies.push_back(b);
         }
         scene.setBodies(bodies);
