@@ -312,19 +312,29 @@ void Runtime::recompilePlan() {
 }
 
 void Runtime::adoptPlan(graph::Plan plan) {
-    // Keep the slot (pass object, textures, programs, skip state) of every pass whose
-    // id and signature are unchanged; everything else starts fresh.
+    // A pass whose id and signature (module, parameters, inputs) are unchanged keeps
+    // everything: pass object, textures, programs, skip state. One whose parameters or
+    // inputs changed keeps its textures where their shape is the same (allocateTextures
+    // decides) and its compiled programs, but gets a fresh pass object and runs again.
+    // Anything else starts fresh.
     std::map<std::string, std::unique_ptr<PassSlot>> old;
     for (auto& s : slots_) old[s->id] = std::move(s);
     std::vector<std::unique_ptr<PassSlot>> next;
-    int kept = 0;
+    int kept = 0, rerun = 0;
     for (auto& planned : plan.passes) {
         auto it = old.find(planned.id);
         std::unique_ptr<PassSlot> slot;
-        if (it != old.end() && it->second->module == planned.module && it->second->signature == planned.signatureHash) {
+        if (it != old.end() && it->second->module == planned.module) {
             slot = std::move(it->second);
             old.erase(it);
-            ++kept;
+            if (slot->signature == planned.signatureHash) {
+                ++kept;
+            } else {
+                slot->pass.reset();  // its cached decisions were made for other parameters
+                slot->signature = planned.signatureHash;
+                slot->error.clear();
+                ++rerun;
+            }
         } else {
             slot = std::make_unique<PassSlot>();
             slot->id = planned.id;
@@ -349,7 +359,7 @@ void Runtime::adoptPlan(graph::Plan plan) {
     for (size_t i = 0; i < slots_.size(); ++i)
         if (plan_->passes[i].state != graph::PassState::Disabled) allocateTextures(*slots_[i], plan_->passes[i]);
     log::info("pipeline ", plan_->fileName, ": ", plan_->runOrder().size(), " of ", plan_->passes.size(),
-              " passes run; kept the resources of ", kept);
+              " passes run; ", kept, " unchanged, ", rerun, " changed in parameters or inputs");
 }
 
 void Runtime::allocateTextures(PassSlot& slot, const graph::PlannedPass& planned) {
@@ -390,6 +400,15 @@ void Runtime::allocateTextures(PassSlot& slot, const graph::PlannedPass& planned
     };
     for (auto& d : planned.decl.outputs) want(d, false);
     for (auto& d : planned.decl.internals) want(d, true);
+    // Textures the declaration no longer has (a reloaded module renamed one) go.
+    for (auto it = slot.textures.begin(); it != slot.textures.end();) {
+        if (!planned.texture(it->first)) {
+            it = slot.textures.erase(it);
+            slot.framebuffers.clear();
+        } else {
+            ++it;
+        }
+    }
 }
 
 void Runtime::resize(int width, int height) {
