@@ -10,7 +10,7 @@ bool App::init(const Options& o, std::string& error) {
     options_ = o;
     paused = o.paused;
     viewed = o.view;
-    RuntimeOptions ro;
+    run::RuntimeOptions ro;
     ro.shaderRoots = {o.shaderRoot};
     // --modules may list several directories, separated by ':'.
     for (size_t start = 0; start <= o.moduleDir.size();) {
@@ -22,8 +22,7 @@ bool App::init(const Options& o, std::string& error) {
     ro.width = o.width;
     ro.height = o.height;
     if (!runtime_.init(ro, error)) return false;
-    if (!world_.load(o.scene, o.seed, error)) return false;
-    runtime_.scene().init(world_.box(), world_.shape());
+    if (!scene_.load(o.scene, seedOverride(), error)) return false;
     if (!viewed.empty()) runtime_.setRequested({viewed});
     std::string errors;
     if (!runtime_.loadPipeline(o.pipeline, errors)) {
@@ -52,51 +51,53 @@ void App::resize(int width, int height) {
     runtime_.resize(width, height);
 }
 
-SceneView App::buildView() const {
+std::optional<uint64_t> App::seedOverride() const {
+    return options_.seed == kSceneSeed ? std::nullopt : std::optional<uint64_t>(options_.seed);
+}
+
+SceneView App::buildView() {
+    scene_.writeTo(renderer_, scene_.sim().dragged());
+    renderer_.upload();
+
     SceneView v;
-    const int w = options_.width, h = options_.height;
-    v.cameraPos = camera_.position();
     const glm::mat4 view = camera_.view();
-    const glm::mat4 proj = camera_.projection(float(w) / float(h));
+    const glm::mat4 proj = camera_.projection(float(options_.width) / float(options_.height));
     v.frame.view = view;
     v.frame.proj = proj;
     v.frame.viewProj = proj * view;
     v.frame.invViewProj = glm::inverse(v.frame.viewProj);
-    v.frame.cameraPos = glm::vec4(v.cameraPos, 1.0f);
-    const BoxLook& box = world_.box();
-    v.lightPos = box.lampCentre;
-    v.lampRadius = box.lampRadius;
-    v.lightColor = box.lampColor * box.lampIntensity;
-    v.frame.lightPos = glm::vec4(box.lampCentre, box.lampRadius);
-    v.frame.lightColor = glm::vec4(v.lightColor, box.lampIntensity);
+    v.frame.cameraPos = glm::vec4(camera_.position(), 1.0f);
+    const scene::SceneLook& look = scene_.look();
+    v.frame.lightPos = glm::vec4(look.lampCentre, look.lampRadius);
+    v.frame.lightColor = glm::vec4(look.lampColor * look.lampIntensity, look.lampIntensity);
+    v.frame.woodLight = glm::vec4(look.woodLight, look.woodRingFrequency);
+    v.frame.woodDark = glm::vec4(look.woodDark, 0.0f);
+
+    if (v.frame.viewProj != lastViewProj_) lastViewProj_ = v.frame.viewProj, ++cameraVersion_;
+    for (int i = 0; i < kSceneGeometryCount; ++i) {
+        const auto c = SceneCategory(1u << i);
+        v.versions[i] = renderer_.version(c);
+        v.counts[i] = renderer_.count(c);
+    }
+    v.versions[sceneCategoryIndex(kSceneLight)] = scene_.generation();
+    v.versions[sceneCategoryIndex(kSceneCamera)] = cameraVersion_;
+    v.versions[sceneCategoryIndex(kSceneTime)] = timeVersion_;
     return v;
 }
 
 void App::frame() {
     live_.poll(*this);  // edits land at a frame boundary, on this thread
     if (!paused || singleStep) {
-        world_.step();
+        scene_.step();
+        ++timeVersion_;
         singleStep = false;
     }
-    SceneView view = buildView();
-    static_assert(sizeof(view.versions) == 6 * sizeof(uint64_t));
-    world_.sync(runtime_.scene(), sceneVersions_, world_.sim().dragged());
-    if (view.frame.viewProj != lastViewProj_) {
-        lastViewProj_ = view.frame.viewProj;
-        ++sceneVersions_[sceneCategoryIndex(kSceneCamera)];
-    }
-    if (!paused) ++sceneVersions_[sceneCategoryIndex(kSceneTime)];
-    std::copy(std::begin(sceneVersions_), std::end(sceneVersions_), view.versions);
-    for (uint32_t bit = 0; bit < 6; ++bit) {
-        view.counts[bit] = runtime_.scene().count(DrawCategory(1u << bit));
-        view.drawVersions[bit] = runtime_.scene().version(DrawCategory(1u << bit));
-    }
-
+    const SceneView view = buildView();
     FrameInfo info;
     info.index = frameIndex_++;
-    info.time = world_.time();
-    info.dt = world_.dt();
-    runtime_.renderFrame(view, info);
+    info.time = scene_.time();
+    info.dt = scene_.dt();
+    runtime_.renderFrame(view, renderer_, info);
 }
 
 const TextureRef* App::displayedTexture() const {

@@ -1,5 +1,8 @@
-// app/app.hpp — one running Kiln: the runtime, the world and the camera, stepped a
-// frame at a time. Shared by the window and the headless front ends.
+// app/app.hpp — one running Kiln: the scene (simulation + look), its renderer, the
+// camera and the runtime, stepped a frame at a time. Shared by the window and the
+// headless front ends. Data flows one way each frame: the live scene steps and writes
+// what changed into the scene renderer; buildView() makes the whole SceneView from the
+// renderer, the camera and the scene's look; the runtime runs the graph over it.
 #pragma once
 
 #include <memory>
@@ -8,10 +11,13 @@
 #include "app/camera.hpp"
 #include "app/cli.hpp"
 #include "app/live.hpp"
-#include "app/runtime.hpp"
-#include "app/world.hpp"
+#include "run/runtime.hpp"
+#include "scene/live_scene.hpp"
+#include "scene/scene_renderer.hpp"
 
 namespace kiln::app {
+
+using run::Runtime;
 
 class App {
 public:
@@ -24,25 +30,27 @@ public:
     // The window's framebuffer changed size: reallocate size-relative textures.
     void resize(int width, int height);
     Runtime& runtime() { return runtime_; }
-    World& world() { return world_; }
+    scene::LiveScene& scene() { return scene_; }
     OrbitCamera& camera() { return camera_; }
     LiveReload& live() { return live_; }
-    uint64_t seed() const { return options_.seed; }
+    // The seed given on the command line, if any (a scene reload keeps it).
+    std::optional<uint64_t> seedOverride() const;
     bool paused = false;
     bool singleStep = false;
     std::string viewed;  // "pass.output" or empty for the graph output
 
 private:
-    SceneView buildView() const;
+    SceneView buildView();
 
     Options options_;
     Runtime runtime_;
-    World world_;
+    scene::LiveScene scene_;
+    scene::SceneRenderer renderer_;
     OrbitCamera camera_;
     LiveReload live_;
     uint64_t frameIndex_ = 0;
     glm::mat4 lastViewProj_{0.0f};
-    uint64_t sceneVersions_[6] = {};
+    uint64_t cameraVersion_ = 0, timeVersion_ = 0;
 };
 
 int runWindow(const Options&);

@@ -30,7 +30,7 @@ void LiveReload::start(App& app) {
     for (auto& root : app.runtime().shaders().roots()) watcher_->watch(root);
     for (auto& dir : app.runtime().loader().dirs()) watcher_->watch(dir);
     watcher_->watch(canonical(app.runtime().pipelineFile()).parent_path());
-    watcher_->watch(canonical(app.world().file()).parent_path());
+    watcher_->watch(canonical(app.scene().file()).parent_path());
 }
 
 int LiveReload::poll(App& app) {
@@ -38,7 +38,7 @@ int LiveReload::poll(App& app) {
     auto changed = watcher_->poll();
     if (changed.empty()) return 0;
     Runtime& rt = app.runtime();
-    const fs::path pipeline = canonical(rt.pipelineFile()), scene = canonical(app.world().file());
+    const fs::path pipeline = canonical(rt.pipelineFile()), scene = canonical(app.scene().file());
     std::vector<fs::path> shaders;
     int reloads = 0;
     for (auto& path : changed) {
@@ -58,7 +58,7 @@ int LiveReload::poll(App& app) {
             }
         } else if (path == scene) {
             std::string error;
-            if (app.world().load(path.string(), app.seed(), error)) {
+            if (app.scene().load(path.string(), app.seedOverride(), error)) {
                 rt.setExternalError("scene", "");
                 log::info("reloaded scene ", path.string(), " in ", msSince(t0), " ms");
                 ++sceneReloads, ++reloads;

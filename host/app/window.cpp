@@ -201,16 +201,16 @@ void panelErrors(App& app) {
 
 void panelScene(App& app) {
     if (!ImGui::CollapsingHeader("Scene", ImGuiTreeNodeFlags_DefaultOpen)) return;
-    auto& sim = app.world().sim();
+    auto& sim = app.scene().sim();
     ImGui::Checkbox("paused (Space)", &app.paused);
     ImGui::SameLine();
     if (ImGui::Button("step (.)")) app.singleStep = true;
     ImGui::SameLine();
-    if (ImGui::Button("reset (R)")) app.world().reset();
+    if (ImGui::Button("reset (R)")) app.scene().reset();
     if (ImGui::Button("spawn marble (M)")) sim.spawnRandom(sim::BallKind::Marble);
     ImGui::SameLine();
     if (ImGui::Button("spawn fireball (F)")) sim.spawnRandom(sim::BallKind::Fireball);
-    ImGui::Text("t = %.2f s, %zu balls, %zu particles", app.world().time(), sim.balls().size(), sim.particles().size());
+    ImGui::Text("t = %.2f s, %zu balls, %zu particles", app.scene().time(), sim.balls().size(), sim.particles().size());
     ImGui::TextUnformatted("drag a tumbler: low to move it, high to tilt it");
 }
 
@@ -292,9 +292,9 @@ int runWindow(const Options& o) {
         if (key == GLFW_KEY_F1) s->showDebug = !s->showDebug;
         if (key == GLFW_KEY_SPACE) s->app->paused = !s->app->paused;
         if (key == GLFW_KEY_PERIOD) s->app->singleStep = true;
-        if (key == GLFW_KEY_M) s->app->world().sim().spawnRandom(sim::BallKind::Marble);
-        if (key == GLFW_KEY_F) s->app->world().sim().spawnRandom(sim::BallKind::Fireball);
-        if (key == GLFW_KEY_R) s->app->world().reset();
+        if (key == GLFW_KEY_M) s->app->scene().sim().spawnRandom(sim::BallKind::Marble);
+        if (key == GLFW_KEY_F) s->app->scene().sim().spawnRandom(sim::BallKind::Fireball);
+        if (key == GLFW_KEY_R) s->app->scene().reset();
     });
     // Ours first: ImGui's GLFW backend chains to the callbacks it finds installed.
     IMGUI_CHECKVERSION();
@@ -317,7 +317,7 @@ int runWindow(const Options& o) {
         int winW, winH;
         glfwGetWindowSize(window, &winW, &winH);
         const bool down = glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS;
-        auto& sim = app.world().sim();
+        auto& sim = app.scene().sim();
         if (down && !ImGui::GetIO().WantCaptureMouse) {
             glm::vec3 origin, dir;
             app.camera().rayThrough(x, y, winW, winH, origin, dir);

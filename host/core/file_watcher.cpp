@@ -9,6 +9,7 @@
 #include <cstring>
 #include <fstream>
 
+#include "kiln/hash.hpp"
 #include "kiln/log.hpp"
 
 namespace fs = std::filesystem;
@@ -20,11 +21,11 @@ namespace {
 uint64_t hashFile(const fs::path& p, bool& ok) {
     std::ifstream in(p, std::ios::binary);
     ok = bool(in);
-    uint64_t h = 1469598103934665603ull;
+    uint64_t h = kFnvOffsetBasis;
     char buf[65536];
     while (in) {
         in.read(buf, sizeof buf);
-        for (std::streamsize i = 0; i < in.gcount(); ++i) h = (h ^ static_cast<unsigned char>(buf[i])) * 1099511628211ull;
+        h = fnv1a(buf, static_cast<size_t>(in.gcount()), h);
     }
     return h;
 }

@@ -1,15 +1,12 @@
 #include "kiln/log.hpp"
 
 #include <cstdio>
-#include <deque>
 #include <mutex>
 
 namespace kiln::log {
 namespace {
-std::mutex gMutex;
-std::deque<std::pair<Level, std::string>> gRing;
+std::mutex gMutex;  // the watcher may log from its own thread
 Level gMin = Level::Info;
-constexpr size_t kRingSize = 1000;
 const char* prefix(Level l) {
     switch (l) {
         case Level::Debug: return "kiln: debug: ";
@@ -30,14 +27,6 @@ void write(Level level, std::string message) {
     std::lock_guard lock(gMutex);
     if (level < gMin) return;
     std::fprintf(stderr, "%s%s\n", prefix(level), message.c_str());
-    gRing.emplace_back(level, std::move(message));
-    if (gRing.size() > kRingSize) gRing.pop_front();
-}
-
-std::vector<std::pair<Level, std::string>> recent(size_t maxLines) {
-    std::lock_guard lock(gMutex);
-    size_t n = std::min(maxLines, gRing.size());
-    return {gRing.end() - static_cast<long>(n), gRing.end()};
 }
 
 }  // namespace kiln::log

@@ -4,9 +4,8 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <regex>
 
-#include "graph/suggest.hpp"
+#include "kiln/names.hpp"
 #include "kiln/log.hpp"
 
 namespace fs = std::filesystem;
@@ -29,11 +28,6 @@ ModuleLoader::~ModuleLoader() {
     // directory goes when it is empty.
     std::error_code ec;
     fs::remove(scratch_, ec);
-}
-
-bool ModuleLoader::isValidName(const std::string& name) {
-    static const std::regex re("[a-z0-9_]+");
-    return !name.empty() && name.size() <= 64 && std::regex_match(name, re);
 }
 
 std::vector<std::string> ModuleLoader::available() const {
@@ -72,7 +66,7 @@ std::string joined(const std::vector<std::string>& v) {
 
 std::shared_ptr<LoadedModule> ModuleLoader::load(const std::string& name, std::string& error) {
     if (!isValidName(name)) {
-        error = "module name \"" + name + "\" is not valid: a module is named by [a-z0-9_]+ (no path, \"..\" or suffix)";
+        error = "module name \"" + name + "\" is not valid: a module is named by " + std::string(kNameRule) + ", no path, \"..\" or suffix";
         return nullptr;
     }
     fs::path source = locate(name);
@@ -80,7 +74,7 @@ std::shared_ptr<LoadedModule> ModuleLoader::load(const std::string& name, std::s
         std::string dirs;
         for (auto& d : dirs_) dirs += (dirs.empty() ? "" : ", ") + d.string();
         auto names = available();
-        std::string hint = graph::nearestName(name, names);
+        std::string hint = nearestName(name, names);
         error = "no module \"" + name + "\" (" + fileNameFor(name) + ") in " + (dirs.empty() ? "no module directory" : dirs) +
                 (hint.empty() ? "" : "; did you mean \"" + hint + "\"?") + " (available: " + joined(names) + ")";
         return nullptr;

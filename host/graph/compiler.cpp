@@ -1,7 +1,8 @@
 // The graph compiler: resolve → bind → cull → sign (see graph/compiler.hpp).
 #include "graph/compiler.hpp"
 
-#include "graph/suggest.hpp"
+#include "kiln/hash.hpp"
+#include "kiln/names.hpp"
 
 #include <algorithm>
 #include <climits>
@@ -13,13 +14,6 @@
 #include <set>
 
 namespace kiln::graph {
-
-bool isValidName(std::string_view s) {
-    if (s.empty()) return false;
-    for (char c : s)
-        if (!((c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_')) return false;
-    return true;
-}
 
 namespace {
 
@@ -119,14 +113,19 @@ std::vector<std::string> checkDeclaration(const PassDeclaration& d) {
                 break;
             case SizeRule::Mode::FromParam: {
                 auto it = std::find_if(d.params.begin(), d.params.end(),
-                                       [&](const ParamDecl& p) { return p.name == t.size.param; });
+                                       [&](const ParamDecl& p) { return p.name == t.size.source; });
                 if (it == d.params.end())
-                    problems.push_back(name + " takes its size from unknown parameter " + q(t.size.param));
+                    problems.push_back(name + " takes its size from unknown parameter " + q(t.size.source));
                 else if (it->type != ParamType::Int)
-                    problems.push_back(name + " takes its size from parameter " + q(t.size.param) + ", which is a " +
+                    problems.push_back(name + " takes its size from parameter " + q(t.size.source) + ", which is a " +
                                        toString(it->type) + ", not an int");
                 break;
             }
+            case SizeRule::Mode::FromInput:
+                if (std::none_of(d.inputs.begin(), d.inputs.end(), [&](const InputDecl& in) { return in.name == t.size.source; }))
+                    problems.push_back(name + " takes its size from unknown input " + q(t.size.source));
+                if (!(t.size.scale > 0.0f)) problems.push_back(name + " has scale " + num(t.size.scale) + " (must be > 0)");
+                break;
         }
         if (t.mips < 0) problems.push_back(name + " has a negative mip count");
     };
@@ -144,19 +143,11 @@ std::string textureKey(const TextureDecl& t) {
             s += std::to_string(t.size.width) + "x" + std::to_string(t.size.height) + "x" + std::to_string(t.size.depth);
             break;
         case SizeRule::Mode::FromParam:
-            s += "param:" + t.size.param + "*" + num(t.size.scale) + "x" + std::to_string(t.size.tiles);
+            s += "param:" + t.size.source + "*" + num(t.size.scale) + "x" + std::to_string(t.size.tiles);
             break;
+        case SizeRule::Mode::FromInput: s += "input:" + t.size.source + "*" + num(t.size.scale); break;
     }
     return s + ":mips" + std::to_string(t.mips);
-}
-
-uint64_t fnv1a(const std::string& s) {
-    uint64_t h = 1469598103934665603ull;
-    for (unsigned char c : s) {
-        h ^= c;
-        h *= 1099511628211ull;
-    }
-    return h;
 }
 
 class Compiler {
@@ -232,8 +223,8 @@ private:
             if (!isValidName(p.id)) {
                 const std::string fixed = sanitizeName(p.id);
                 error(ii, passPath(ii) + ".id",
-                      p.id.empty() ? std::string("empty id: ids must match [a-z0-9_]+")
-                                   : "bad id " + q(p.id) + ": ids must match [a-z0-9_]+" +
+                      p.id.empty() ? std::string("empty id: ids must match ") + kNameRule
+                                   : "bad id " + q(p.id) + ": ids must match " + kNameRule +
                                          (fixed.empty() ? std::string() : " (e.g. " + q(fixed) + ")"));
             }
             // Even a bad id is indexed, so bindings that name it don't cascade into
@@ -259,7 +250,7 @@ private:
             std::string message = p.module.empty()
                                       ? std::string("empty module name")
                                       : "bad module name " + q(p.module) +
-                                            ": a module is named by [a-z0-9_]+ (no path, no suffix)";
+                                            ": a module is named by " + kNameRule + ", no path, no suffix";
             // "../passes/bloom.so" probably meant "bloom".
             std::string base = p.module.substr(p.module.find_last_of("/\\") + 1);
             base = base.substr(0, base.find('.'));

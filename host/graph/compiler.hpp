@@ -37,6 +37,7 @@
 #include "graph/pipeline.hpp"
 #include "graph/plan.hpp"
 #include "kiln/declare.hpp"
+#include "kiln/names.hpp"
 
 #include <functional>
 #include <string_view>
@@ -67,8 +68,5 @@ Result<Plan> compile(const PipelineDesc&, const CompileOptions&);
 
 // parsePipeline + compile.
 Result<Plan> compileText(const std::string& text, const std::string& fileName, const CompileOptions&);
-
-// True when `s` is a valid pass id or module name: [a-z0-9_]+.
-bool isValidName(std::string_view s);
 
 }  // namespace kiln::graph

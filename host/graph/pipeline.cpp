@@ -3,7 +3,7 @@
 #include "graph/pipeline.hpp"
 
 #include "graph/plan.hpp"  // formatParamValue
-#include "graph/suggest.hpp"
+#include "kiln/names.hpp"
 
 #include <nlohmann/json.hpp>
 

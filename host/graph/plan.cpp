@@ -117,7 +117,7 @@ std::vector<int> Plan::runOrder() const {
 
 // ---- sizes -----------------------------------------------------------------------
 
-Extent resolveSize(const TextureDecl& t, int outW, int outH, const ResolvedParams& params) {
+Extent resolveSize(const TextureDecl& t, int outW, int outH, const ResolvedParams& params, const Extent* input) {
     const bool is3D = t.kind == TextureKind::Color3D;
     Extent e;
     switch (t.size.mode) {
@@ -136,15 +136,36 @@ Extent resolveSize(const TextureDecl& t, int outW, int outH, const ResolvedParam
             e.d = is3D ? std::max(1, t.size.depth) : 1;
             break;
         case SizeRule::Mode::FromParam: {
-            const int* side = params.get<int>(t.size.param);
+            const int* side = params.get<int>(t.size.source);
             const int s = side ? std::max(1, int(std::lround(*side * double(t.size.scale)))) : 1;
             e.w = s * std::max(1, t.size.tiles);
             e.h = s;
             e.d = is3D ? s : 1;
             break;
         }
+        case SizeRule::Mode::FromInput: {
+            if (!input) break;  // unbound optional input: its fallback is 1×1(×1)
+            auto side = [&](int v) { return std::max(1, int(std::lround(v * double(t.size.scale)))); };
+            e.w = side(input->w);
+            e.h = side(input->h);
+            e.d = is3D ? side(input->d) : 1;
+            break;
+        }
     }
     return e;
+}
+
+Extent Plan::extentOf(int pass, std::string_view name, int outW, int outH) const {
+    if (pass < 0 || pass >= static_cast<int>(passes.size())) return {};
+    const PlannedPass& p = passes[static_cast<size_t>(pass)];
+    const TextureDecl* t = p.texture(name);
+    if (!t) return {};
+    if (t->size.mode != SizeRule::Mode::FromInput) return resolveSize(*t, outW, outH, p.params);
+    // Producers come earlier in file order, so this recursion ends.
+    const Binding* b = p.binding(t->size.source);
+    if (!b || !b->bound() || b->producer >= pass) return resolveSize(*t, outW, outH, p.params);
+    const Extent in = extentOf(b->producer, b->output, outW, outH);
+    return resolveSize(*t, outW, outH, p.params, &in);
 }
 
 std::string describeSize(const TextureDecl& t, const ResolvedParams& params) {
@@ -160,9 +181,14 @@ std::string describeSize(const TextureDecl& t, const ResolvedParams& params) {
             if (is3D) s += "x" + std::to_string(t.size.depth);
             return s;
         }
+        case SizeRule::Mode::FromInput: {
+            std::string d = "as input " + t.size.source;
+            if (t.size.scale != 1.0f) d = std::to_string(t.size.scale).substr(0, 4) + "× " + d;
+            return d;
+        }
         case SizeRule::Mode::FromParam: {
-            const int* side = params.get<int>(t.size.param);
-            std::string d = (side ? std::to_string(*side) : std::string("?")) + (is3D ? "³" : "²") + " (" + t.size.param + ")";
+            const int* side = params.get<int>(t.size.source);
+            std::string d = (side ? std::to_string(*side) : std::string("?")) + (is3D ? "³" : "²") + " (" + t.size.source + ")";
             if (t.size.scale != 1.0f) d = std::to_string(t.size.scale).substr(0, 4) + "×" + d;
             if (t.size.tiles > 1) d += " ×" + std::to_string(t.size.tiles) + " tiles";
             return d;

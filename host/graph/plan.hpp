@@ -84,6 +84,11 @@ struct TextureRef {
     bool valid() const { return pass >= 0; }
 };
 
+struct Extent {
+    int w = 1, h = 1, d = 1;
+    bool operator==(const Extent&) const = default;
+};
+
 struct Plan {
     std::string fileName;
     std::vector<PlannedPass> passes;     // file order = execution order
@@ -93,6 +98,9 @@ struct Plan {
 
     int find(std::string_view id) const;       // index or -1
     std::vector<int> runOrder() const;         // indices of the passes that run
+    // The extent of pass `pass`'s output or internal `name` for a graph output of
+    // outW×outH, following FromInput sizes through the bindings ({1,1,1} if unknown).
+    Extent extentOf(int pass, std::string_view name, int outW, int outH) const;
 
     // Fixed-width text table: #, id, module, state (and why), inputs
     // (slot←pass.output or slot←fallback:black), outputs (name format size-rule).
@@ -102,17 +110,13 @@ struct Plan {
     std::string dot() const;
 };
 
-struct Extent {
-    int w = 1, h = 1, d = 1;
-    bool operator==(const Extent&) const = default;
-};
-
 // The size of an output/internal texture for a graph output of outW×outH:
 // RelativeToOutput: round(scale × out), at least 1 (2D);
 // Fixed: width × height (× depth for 3D);
-// FromParam: a square (2D) or cube (3D) whose side is the int parameter (at least 1).
+// FromParam: a square (2D) or cube (3D) whose side is the int parameter (at least 1);
+// FromInput: `input` (the extent of what is bound to the slot) × scale, 1 when null.
 // compile() guarantees FromParam names an int parameter; if it does not, the side is 1.
-Extent resolveSize(const TextureDecl&, int outW, int outH, const ResolvedParams&);
+Extent resolveSize(const TextureDecl&, int outW, int outH, const ResolvedParams&, const Extent* input = nullptr);
 
 // "1x", "0.5x", "256x256", "64x64x64", "size(=2048)" — as the table prints it.
 std::string describeSize(const TextureDecl&, const ResolvedParams&);

@@ -13,14 +13,15 @@
 // seed's "bright part of the G-buffer colour"); direct-lit surfaces stay around 1 and
 // would not pass a threshold of 1 anyway. No lighting/composite split is needed.
 //
-// Nothing to do: a small compute reduction first finds the brightest luminance of the
-// input (one atomicMax per 8×8 group of 4×4 texel tiles, read back as 4 bytes). Below
-// the threshold the output is cleared once and the pass then reports nothing to do.
+// Nothing bright: a small compute reduction first finds the brightest luminance of the
+// input (one atomicMax per 8×8 group of 4×4 texel tiles) into a 4-byte buffer that the
+// blur reads; below the threshold every blur fragment writes black without a single
+// tap. The value never comes back to the CPU: a read-back right after the dispatch
+// would stall the CPU on the GPU every frame.
 #include <kiln/pass.hpp>
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <string>
 
 namespace {
@@ -41,9 +42,7 @@ public:
                        .doc = "bright-pass + horizontal blur"})
             .param(floatParam("threshold", 1.0f, 0.0, 64.0, "luminance below which nothing blooms"))
             .param(intParam("radius", 4, 1, 16, "blur radius in pixels: taps = 2·radius+1 per axis (4 = 9×9)"))
-            .param(floatParam("intensity", 0.6f, 0.0, 8.0, "scales the blurred light"))
-            .shader("bloom/max.comp")
-            .shader("bloom/blur.frag");
+            .param(floatParam("intensity", 0.6f, 0.0, 8.0, "scales the blurred light"));
         return d;
     }
 
@@ -54,10 +53,10 @@ public:
         const kiln::TextureRef& in = ctx.input("color");
         const float threshold = ctx.getFloat("threshold");
 
-        // 1. Anything above the threshold?
+        // 1. The brightest luminance, for the blur's early out.
         if (!maxBuffer_) {
             glCreateBuffers(1, &maxBuffer_);
-            glNamedBufferStorage(maxBuffer_, 4, nullptr, GL_DYNAMIC_STORAGE_BIT | GL_MAP_READ_BIT);
+            glNamedBufferStorage(maxBuffer_, 4, nullptr, GL_DYNAMIC_STORAGE_BIT);
         }
         const GLuint zero = 0;
         glNamedBufferSubData(maxBuffer_, 0, 4, &zero);
@@ -65,21 +64,7 @@ public:
         glBindTextureUnit(0, in.id);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, maxBuffer_);
         glDispatchCompute(GLuint((in.width + 31) / 32), GLuint((in.height + 31) / 32), 1);
-        glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-        GLuint bits = 0;
-        glGetNamedBufferSubData(maxBuffer_, 0, 4, &bits);
-        float maxLum;
-        std::memcpy(&maxLum, &bits, 4);
-        if (!(maxLum > threshold)) {
-            if (clear_) {
-                ctx.nothingToDo("nothing brighter than the threshold");
-                return;
-            }
-            glClearTexImage(ctx.output("bloom").id, 0, GL_RGBA, GL_FLOAT, nullptr);
-            clear_ = true;
-            return;
-        }
-        clear_ = false;
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
 
         // 2. Bright-pass + horizontal blur → ping; vertical blur → bloom.
         glUseProgram(blur);
@@ -101,8 +86,7 @@ public:
     }
 
 private:
-    GLuint maxBuffer_ = 0;  // 4 bytes: the brightest luminance (float bits)
-    bool clear_ = false;    // the output holds the cleared "nothing blooms" state
+    GLuint maxBuffer_ = 0;  // 4 bytes: the brightest luminance (float bits), GPU only
 };
 
 }  // namespace

@@ -26,8 +26,7 @@ public:
             .param(floatParam("gamma", 2.2f, 1.0, 3.0))
             .param(intChoiceParam("pcf", 5, {1, 3, 5, 7, 9}, "shadow filter kernel side: 5 = the seed's 5x5, 1 = hard"))
             .param(floatParam("indirect_strength", 1.0f, 0.0, 8.0, "scales the bound indirect irradiance (1 = physical)"))
-            .param(floatParam("shadow_bias", 0.0005f, 0.0, 0.05, "depth bias of the shadow test"))
-            .shader("composite/composite.frag");
+            .param(floatParam("shadow_bias", 0.0005f, 0.0, 0.05, "depth bias of the shadow test"));
         d.reads = kSceneLight | kSceneCamera;
         return d;
     }

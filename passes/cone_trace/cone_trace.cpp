@@ -129,11 +129,7 @@ public:
             .param(floatParam("diameter_offset", 0.5f, 0.0, 2.0,
                               "each sample pushed off the surface by this × its diameter (against self-occlusion)"))
             .param(boolParam("half_res", false, "trace at half resolution and upsample (depth/normal aware)"))
-            .param(floatParam("upsample_tolerance", 0.02f, 0.001, 1.0, "plane distance (world) that halves a sample's weight"))
-            .shader("cone_trace/cone_trace.frag")
-            .shader("cone_trace/upsample.frag")
-            .shader("cone_trace/trace.glsl")
-            .shader("cone_trace/voxels.glsl");
+            .param(floatParam("upsample_tolerance", 0.02f, 0.001, 1.0, "plane distance (world) that halves a sample's weight"));
         d.reads = kSceneCamera;
         return d;
     }

@@ -13,9 +13,7 @@ public:
             .output({.name = "normal", .format = Format::RGBA16F, .doc = "world-space unit normal; w = 1 on geometry"})
             .output({.name = "emissive", .format = Format::RGBA16F, .doc = "emitted radiance"})
             .output({.name = "depth", .kind = TextureKind::Depth2D, .format = Format::Depth32F})
-            .param(boolParam("particles", true, "draw the particles"))
-            .shader("gbuffer/gbuffer.vert")
-            .shader("gbuffer/gbuffer.frag");
+            .param(boolParam("particles", true, "draw the particles"));
         d.reads = kSceneStatic | kSceneBodies | kSceneParticles | kSceneCamera;
         return d;
     }
@@ -31,8 +29,8 @@ public:
         glDepthFunc(GL_LESS);
         glUseProgram(program);
         kiln::DrawFilter filter;
-        filter.categories = kiln::kDrawAll;
-        if (!ctx.getBool("particles")) filter.categories &= ~kiln::kDrawParticles;
+        filter.categories = kiln::kSceneGeometry;
+        if (!ctx.getBool("particles")) filter.categories &= ~kiln::kSceneParticles;
         ctx.drawScene(filter);
     }
 };

@@ -1,7 +1,8 @@
 // voxel_mip — mip chains of the voxel radiance (SPEC §6.4), compute shaders in 4³
 // workgroups, one dispatch per level.
 //
-// Outputs (both res³ cubes with a full mip chain; colours premultiplied by opacity):
+// Outputs (both the input's res³, SizeRule::fromInput, with a full mip chain; colours
+// premultiplied by opacity):
 //   iso    level 0 = a copy of the input, level k = the mean of its 2×2×2 children
 //          (colour and opacity). Always built: it is cheap (1/7 of the voxels) and it
 //          is level 0 of the anisotropic lookups and the voxel_view's volume.
@@ -28,17 +29,14 @@ public:
     kiln::PassDeclaration declare() const override {
         using namespace kiln;
         PassDeclaration d;
-        const auto cube = SizeRule::fromParam("resolution");
+        const auto cube = SizeRule::fromInput("radiance");
         d.input({.name = "radiance", .kind = TextureKind::Color3D, .doc = "voxelize.radiance"})
             .output({.name = "iso", .kind = TextureKind::Color3D, .format = Format::RGBA16F, .size = cube,
                      .mips = kFullMipChain, .doc = "isotropic chain; level 0 = the input"})
             .output({.name = "aniso", .kind = TextureKind::Color3D, .format = Format::RGBA16F, .size = cube,
                      .mips = kFullMipChain,
                      .doc = "six directional chains as octants; atlas level k = directional level k+1"})
-            .param(enumParam("mode", "aniso", {"iso", "aniso"}, "build the anisotropic chains too"))
-            .param(intChoiceParam("resolution", 64, {8, 16, 32, 64, 128}, "must match voxelize's resolution"))
-            .shader("voxel_mip/iso.comp")
-            .shader("voxel_mip/aniso.comp");
+            .param(enumParam("mode", "aniso", {"iso", "aniso"}, "build the anisotropic chains too"));
         return d;
     }
 
@@ -49,12 +47,7 @@ public:
         const kiln::TextureRef& in = ctx.input("radiance");
         const kiln::TextureRef& chain = ctx.output("iso");
         const kiln::TextureRef& atlas = ctx.output("aniso");
-        const int res = chain.width;
-        if (in.width != res || in.height != res || in.depth != res) {
-            ctx.fail("radiance input is " + std::to_string(in.width) + "^3 but resolution is " + std::to_string(res) +
-                     ": set the same resolution on voxelize and voxel_mip");
-            return;
-        }
+        const int res = chain.width;  // = the input's (SizeRule::fromInput)
         glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
         glCopyImageSubData(in.id, GL_TEXTURE_3D, 0, 0, 0, 0, chain.id, GL_TEXTURE_3D, 0, 0, 0, 0, res, res, res);
 

@@ -15,8 +15,7 @@ public:
             .output({.name = "color", .format = Format::RGBA8, .doc = "tonemapped, gamma-encoded view"})
             .param(intParam("mip", 0, 0, 7, "mip level to show (clamped to the volume's levels)"))
             .param(floatParam("exposure", 1.0f, 0.01, 16.0))
-            .param(floatParam("min_opacity", 0.01f, 0.0, 1.0, "voxels less opaque than this are skipped"))
-            .shader("voxel_view/voxel_view.frag");
+            .param(floatParam("min_opacity", 0.01f, 0.0, 1.0, "voxels less opaque than this are skipped"));
         d.reads = kSceneCamera;
         return d;
     }

@@ -64,11 +64,7 @@ public:
             .param(floatParam("lamp_emission", 0.0f, 0.0, 1.0,
                               "scale of the lamp dome's own emission in the voxels (its light already arrives "
                               "through composite's direct term: 1 counts it twice)"))
-            .param(floatParam("shadow_bias", 0.002f, 0.0, 0.05, "depth bias of the (hard) shadow test"))
-            .shader("voxelize/voxelize.vert")
-            .shader("voxelize/voxelize.geom")
-            .shader("voxelize/voxelize.frag")
-            .shader("voxelize/resolve.comp");
+            .param(floatParam("shadow_bias", 0.002f, 0.0, 0.05, "depth bias of the (hard) shadow test"));
         d.reads = kSceneStatic | kSceneBodies | kSceneParticles | kSceneLight;
         return d;
     }
@@ -102,14 +98,14 @@ public:
         glBindTextureUnit(0, ctx.input("shadow_map").id);
         for (int i = 0; i < 4; ++i)
             glBindImageTexture(GLuint(i), ctx.internal(sums[i]).id, 0, GL_TRUE, 0, GL_READ_WRITE, GL_R32UI);
-        uint32_t cats = kiln::kDrawBox | kiln::kDrawTumblers | kiln::kDrawFireballs;
-        if (ctx.getBool("particles")) cats |= kiln::kDrawParticles;
-        if (ctx.getBool("marbles")) cats |= kiln::kDrawMarbles;
+        uint32_t cats = kiln::kSceneBox | kiln::kSceneTumblers | kiln::kSceneFireballs;
+        if (ctx.getBool("particles")) cats |= kiln::kSceneParticles;
+        if (ctx.getBool("marbles")) cats |= kiln::kSceneMarbles;
         const GLint emissionScale = glGetUniformLocation(raster, "u_emissionScale");
         glUniform1f(emissionScale, 1.0f);
         ctx.drawScene({.categories = cats, .lod = kiln::Lod::Low});
         glUniform1f(emissionScale, ctx.getFloat("lamp_emission"));
-        ctx.drawScene({.categories = kiln::kDrawLamp, .lod = kiln::Lod::Low});
+        ctx.drawScene({.categories = kiln::kSceneLamp, .lod = kiln::Lod::Low});
         glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
 
         // 4: resolve the averages.

@@ -11,6 +11,8 @@ uniform float u_threshold;
 uniform float u_sigma;
 uniform float u_gain;
 uniform int u_brightPass;
+// The input's brightest luminance (bloom/max.comp): nothing above the threshold ⇒ black.
+layout(std430, binding = 1) readonly buffer MaxLum { uint u_maxBits; };
 
 layout(location = 0) out vec4 o_color;
 
@@ -28,6 +30,10 @@ vec3 tap(ivec2 q) {
 }
 
 void main() {
+    if (!(uintBitsToFloat(u_maxBits) > u_threshold)) {
+        o_color = vec4(0.0, 0.0, 0.0, 1.0);
+        return;
+    }
     ivec2 p = ivec2(gl_FragCoord.xy);
     ivec2 size = u_brightPass == 1 ? (textureSize(u_src, 0) + 1) / 2 : textureSize(u_src, 0);
     vec3 sum = vec3(0.0);

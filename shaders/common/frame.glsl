@@ -9,4 +9,6 @@ layout(std140, binding = 0) uniform KilnFrame {
     vec4 u_lightColor;   // rgb × intensity, w = intensity
     vec4 u_outputSize;   // w, h, 1/w, 1/h
     vec4 u_time;         // seconds, dt, frame index
+    vec4 u_woodLight;    // the floor's wood (scene file box.floor_wood): rgb, w = rings per metre
+    vec4 u_woodDark;     // rgb
 };

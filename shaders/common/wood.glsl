@@ -1,16 +1,16 @@
 // A procedural wood grain for the floor: growth rings around a log axis running
-// along x below the floor, warped by value noise, modulating the base colour.
+// along x below the floor, warped by value noise, between the scene file's light and
+// dark wood colours (u_woodLight, u_woodDark from common/frame.glsl; include it first).
 float kilnHash(vec2 p) { return fract(sin(dot(p, vec2(127.1, 311.7))) * 43758.5453); }
 float kilnNoise(vec2 p) {
     vec2 i = floor(p), f = fract(p);
     vec2 u = f * f * (3.0 - 2.0 * f);
     return mix(mix(kilnHash(i), kilnHash(i + vec2(1, 0)), u.x), mix(kilnHash(i + vec2(0, 1)), kilnHash(i + vec2(1, 1)), u.x), u.y);
 }
-vec3 woodGrain(vec3 world, vec3 base) {
+vec3 woodGrain(vec3 world) {
     vec2 p = world.xz;
     float warp = kilnNoise(p * vec2(1.5, 6.0)) * 0.6 + kilnNoise(p * vec2(6.0, 24.0)) * 0.15;
-    float r = length(vec2(p.y * 3.0, 1.7)) * 9.0 + warp * 3.0 + p.x * 0.8;
+    float r = length(vec2(p.y * 3.0, 1.7)) * u_woodLight.w + warp * 3.0 + p.x * 0.8;
     float ring = smoothstep(0.0, 0.6, abs(fract(r) - 0.5) * 2.0);
-    vec3 light = vec3(0.78, 0.56, 0.34), dark = vec3(0.52, 0.33, 0.18);
-    return mix(dark, light, ring) * (base / max(max(base.r, base.g), max(base.b, 1e-3)));
+    return mix(u_woodDark.rgb, u_woodLight.rgb, ring);
 }

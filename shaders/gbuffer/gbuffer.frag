@@ -15,7 +15,7 @@ layout(location = 2) out vec4 o_emissive;  // rgb radiance
 void main() {
     KilnInstance inst = kiln_instances[v_instance];
     vec3 albedo = inst.albedo.rgb;
-    if (inst.albedo.a > 0.5) albedo = woodGrain(v_world, albedo);
+    if (inst.albedo.a > 0.5) albedo = woodGrain(v_world);
     vec3 n = normalize(v_normal);
     if (!gl_FrontFacing) n = -n;
     vec3 emissive = inst.emissive.rgb;

@@ -34,7 +34,7 @@ void main() {
 
     KilnInstance inst = kiln_instances[v_instance];
     vec3 albedo = inst.albedo.rgb;
-    if (inst.albedo.a > 0.5) albedo = woodGrain(v_world, albedo);
+    if (inst.albedo.a > 0.5) albedo = woodGrain(v_world);
     vec3 n = normalize(v_normal);
     float vis = 1.0;
 #if KILN_HAS_SHADOW_MAP

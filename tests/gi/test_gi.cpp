@@ -211,7 +211,7 @@ TEST_CASE("voxel_mip: every level of a constant volume equals it (iso and all si
     rig.load(pipeline("voxel_view.color", R"(
         {"id": "volume", "module": "gi_volume", "params": {"pattern": "solid", "resolution": 32}},
         {"id": "voxel_mip", "module": "voxel_mip", "inputs": {"radiance": "volume.radiance"},
-         "params": {"mode": "aniso", "resolution": 32}},
+         "params": {"mode": "aniso"}},
         {"id": "voxel_view", "module": "voxel_view", "inputs": {"voxels": "voxel_mip.iso"}})"),
              {"voxel_mip.aniso"});
     rig.app.frame();
@@ -255,7 +255,7 @@ TEST_CASE("voxel_mip: anisotropic levels composite front to back along their dir
     rig.load(pipeline("voxel_view.color", R"(
         {"id": "volume", "module": "gi_volume", "params": {"pattern": "layers", "resolution": 16}},
         {"id": "voxel_mip", "module": "voxel_mip", "inputs": {"radiance": "volume.radiance"},
-         "params": {"mode": "aniso", "resolution": 16}},
+         "params": {"mode": "aniso"}},
         {"id": "voxel_view", "module": "voxel_view", "inputs": {"voxels": "voxel_mip.iso"}})"),
              {"voxel_mip.aniso"});
     rig.app.frame();
@@ -319,7 +319,7 @@ TEST_CASE("cone_trace: a box lit by one emissive wall lights the opposite wall m
         {"id": "gbuffer", "module": "gbuffer"},
         {"id": "volume", "module": "gi_volume", "params": {"pattern": "emissive_wall", "resolution": 32}},
         {"id": "voxel_mip", "module": "voxel_mip", "inputs": {"radiance": "volume.radiance"},
-         "params": {"mode": "aniso", "resolution": 32}},
+         "params": {"mode": "aniso"}},
         {"id": "cone_trace", "module": "cone_trace",
          "inputs": {"normal": "gbuffer.normal", "depth": "gbuffer.depth", "voxels": "voxel_mip.iso",
                     "aniso": "voxel_mip.aniso"}})"),
@@ -355,7 +355,7 @@ std::string seedPipeline(const std::string& mode, int res) {
         {"id": "shadow", "module": "shadow", "params": {"size": 512}},
         {"id": "voxelize", "module": "voxelize", "inputs": {"shadow_map": "shadow.depth"}, "params": {"resolution": )" + r + R"(}},
         {"id": "voxel_mip", "module": "voxel_mip", "inputs": {"radiance": "voxelize.radiance"},
-         "params": {"mode": ")" + mode + R"(", "resolution": )" + r + R"(}},
+         "params": {"mode": ")" + mode + R"("}},
         {"id": "cone_trace", "module": "cone_trace",
          "inputs": {"normal": "gbuffer.normal", "depth": "gbuffer.depth", "voxels": "voxel_mip.iso")" + aniso + R"(}},
         {"id": "bloom", "module": "bloom", "inputs": {"color": "gbuffer.emissive"}},

@@ -81,7 +81,7 @@ TEST_CASE("duplicate id", "[errors]") {
 TEST_CASE("bad id", "[errors]") {
     const std::string e = errorsOf(R"({ "output": "gbuffer.albedo", "passes": [
         { "id": "gbuffer", "module": "gbuffer" }, { "id": "Shadow Map", "module": "shadow" } ] })");
-    CHECK_THAT(e, Contains("passes[1].id: bad id \"Shadow Map\": ids must match [a-z0-9_]+ (e.g. \"shadow_map\")"));
+    CHECK_THAT(e, Contains("passes[1].id: bad id \"Shadow Map\": ids must match [a-z0-9_]+ (at most 64 characters) (e.g. \"shadow_map\")"));
 }
 
 TEST_CASE("input bound to a missing pass suggests the nearest id", "[errors]") {

@@ -1,7 +1,7 @@
 // Reading pipeline files: syntax errors with line:col, shape errors with JSON paths,
 // and writing a pipeline back.
 #include "fake_modules.hpp"
-#include "graph/suggest.hpp"
+#include "kiln/names.hpp"
 
 #include <catch2/catch.hpp>
 

@@ -75,12 +75,15 @@ TEST_CASE("the shadow pass is skipped while no caster moves and runs when one do
     CHECK(rig.stateOf("shadow") == "ran");
     rig.app.frame();  // paused: nothing changed
     CHECK(rig.stateOf("shadow") == "skipped");
-    // A new fireball changes the bodies but casts no shadow: the pass says so.
-    rig.app.world().sim().spawnFireball(sim::Vec3(0.0, 0.5, 0.0), sim::Vec3(1.0, 0.0, 0.0));
+    // A new fireball changes the bodies but casts no shadow: the shadow pass reads only
+    // the casters (kSceneShadowCasters), so the host skips it while the G-buffer,
+    // which draws every body, runs again.
+    rig.app.scene().sim().spawnFireball(sim::Vec3(0.0, 0.5, 0.0), sim::Vec3(1.0, 0.0, 0.0));
     rig.app.frame();
-    CHECK(rig.stateOf("shadow") == "nothing to do");
+    CHECK(rig.stateOf("gbuffer") == "ran");
+    CHECK(rig.stateOf("shadow") == "skipped");
     // Dragging a tumbler moves a caster: the map is redrawn.
-    auto& sim = rig.app.world().sim();
+    auto& sim = rig.app.scene().sim();
     const sim::Vec3 p = sim.tumblers()[2].position;
     auto hit = sim.raycastTumblers(p + sim::Vec3(0, -0.1, 2.0), sim::Vec3(0, 0, -1));
     REQUIRE(hit);
@@ -93,7 +96,7 @@ TEST_CASE("the shadow pass is skipped while no caster moves and runs when one do
 
 TEST_CASE("the ray through a tumbler's projected centre picks that tumbler", "[scene][gl]") {
     Rig rig({}, 160);
-    auto& sim = rig.app.world().sim();
+    auto& sim = rig.app.scene().sim();
     for (int i = 0; i < int(sim.tumblers().size()); ++i) {
         const sim::Vec3 c = sim.tumblers()[size_t(i)].position;
         glm::vec2 px = rig.pixelOf(glm::vec3(c), 160);

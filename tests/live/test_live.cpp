@@ -179,12 +179,12 @@ TEST_CASE("a rebuilt module is swapped in with its parameters kept; a broken one
 TEST_CASE("a scene edit resets the world; an invalid scene keeps it", "[live][gl]") {
     Sandbox box("scene-edit");
     const fs::path scene = box.root / "scenes/cornell.json";
-    REQUIRE(box.app.world().sim().tumblers().size() == 5);
+    REQUIRE(box.app.scene().sim().tumblers().size() == 5);
     writeByRename(scene, R"({"tumblers": [{"position": [0.0, 0.0]}]})");
-    CHECK(box.waitFor([&] { return box.app.world().sim().tumblers().size() == 1; }));
+    CHECK(box.waitFor([&] { return box.app.scene().sim().tumblers().size() == 1; }));
     writeInPlace(scene, R"({"tumblers": [{"position": [0.0, 0.0], "colour": [1, 0, 0]}]})");
     CHECK(box.waitFor([&] { return box.errorMentions("tumblers[0].colour: unknown key"); }));
-    CHECK(box.app.world().sim().tumblers().size() == 1);
+    CHECK(box.app.scene().sim().tumblers().size() == 1);
 }
 
 TEST_CASE("ten saves in a burst cause one reload", "[live][gl]") {

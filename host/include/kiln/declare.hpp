@@ -1,5 +1,5 @@
 // kiln/declare.hpp — what a pass *declares*: inputs, outputs, internal textures,
-// parameters, shader files and the scene categories it reads.
+// parameters and the scene categories it reads.
 //
 // This half of the pass ABI has no OpenGL in it, so the graph compiler (and its
 // tests) can validate a pipeline against declarations without a GL context. Pass
@@ -49,17 +49,22 @@ struct SizeRule {
         Fixed,             // width × height (× depth for 3D)
         FromParam,         // a square (2D) or cube (3D) whose side is an int parameter × scale;
                            // `tiles` such blocks side by side along x (a slab atlas)
+        FromInput,         // the size of what is bound to input `source` (× scale per side;
+                           // 1×1(×1) when an optional input is unbound)
     };
     Mode mode = Mode::RelativeToOutput;
     float scale = 1.0f;
     int width = 0, height = 0, depth = 1;
-    std::string param;
+    std::string source;  // FromParam: the int parameter; FromInput: the input slot
     int tiles = 1;
 
     static SizeRule relative(float s = 1.0f) { return {Mode::RelativeToOutput, s, 0, 0, 1, {}, 1}; }
     static SizeRule fixed(int w, int h, int d = 1) { return {Mode::Fixed, 1.0f, w, h, d, {}, 1}; }
     static SizeRule fromParam(std::string name, float scale = 1.0f, int tiles = 1) {
         return {Mode::FromParam, scale, 0, 0, 1, std::move(name), tiles};
+    }
+    static SizeRule fromInput(std::string slot, float scale = 1.0f) {
+        return {Mode::FromInput, scale, 0, 0, 1, std::move(slot), 1};
     }
 };
 
@@ -99,26 +104,36 @@ struct ParamDecl {
     std::string doc;
 };
 
-// Parts of the scene view a pass reads; the host re-runs a pass only when one of
-// these, its inputs or its parameters changed (unless it is time-dependent).
+// Parts of the scene. One set of bits serves two purposes: a pass's `reads` (the host
+// re-runs it only when one of these, its inputs or its parameters changed, unless it
+// is time-dependent) and drawScene()'s filter (the geometry bits).
 enum SceneCategory : uint32_t {
     kSceneNone = 0,
-    kSceneStatic = 1u << 0,     // Cornell box, lamp geometry
-    kSceneBodies = 1u << 1,     // tumblers, marbles, fireballs
-    kSceneParticles = 1u << 2,
-    kSceneLight = 1u << 3,
-    kSceneCamera = 1u << 4,
-    kSceneTime = 1u << 5,
-    kSceneAll = 0x3f,
+    kSceneBox = 1u << 0,        // the five walls (the floor carries the wood grain)
+    kSceneLamp = 1u << 1,       // the emissive dome under the ceiling
+    kSceneTumblers = 1u << 2,
+    kSceneMarbles = 1u << 3,
+    kSceneFireballs = 1u << 4,
+    kSceneParticles = 1u << 5,
+    kSceneLight = 1u << 6,      // the lamp's position, size and radiance
+    kSceneCamera = 1u << 7,
+    kSceneTime = 1u << 8,
+
+    kSceneStatic = kSceneBox | kSceneLamp,
+    kSceneBodies = kSceneTumblers | kSceneMarbles | kSceneFireballs,
+    kSceneShadowCasters = kSceneTumblers | kSceneMarbles,  // fireballs emit, they don't cast
+    kSceneGeometry = 0x3f,      // what drawScene() can draw
+    kSceneAll = 0x1ff,
 };
+inline constexpr int kSceneCategoryCount = 9;
+inline constexpr int kSceneGeometryCount = 6;
 
 struct PassDeclaration {
     std::vector<InputDecl> inputs;
     std::vector<TextureDecl> outputs;
     std::vector<TextureDecl> internals;
     std::vector<ParamDecl> params;
-    std::vector<std::string> shaders;   // paths relative to a shader root, for the watcher
-    uint32_t reads = kSceneNone;        // SceneCategory bits
+    uint32_t reads = kSceneNone;        // SceneCategory bits (kSceneBodies | kSceneCamera, ...)
     bool timeDependent = false;         // run every frame regardless of versions
 
     // Fluent helpers so a pass's declare() reads like a table.
@@ -126,7 +141,6 @@ struct PassDeclaration {
     PassDeclaration& output(TextureDecl d) { outputs.push_back(std::move(d)); return *this; }
     PassDeclaration& internal(TextureDecl d) { internals.push_back(std::move(d)); return *this; }
     PassDeclaration& param(ParamDecl d) { params.push_back(std::move(d)); return *this; }
-    PassDeclaration& shader(std::string path) { shaders.push_back(std::move(path)); return *this; }
 };
 
 // Shorthands for the common declarations.

@@ -1,11 +1,10 @@
-// kiln/log.hpp — one log for the host and every module. Lines go to stderr and to
-// an in-memory ring the debug view shows; tests can read it back.
+// kiln/log.hpp — one log for the host and every module; lines go to stderr. Errors a
+// user must see in the window travel as values (Runtime::activeErrors), not via the log.
 #pragma once
 
 #include <sstream>
 #include <string>
 #include <utility>
-#include <vector>
 
 namespace kiln {
 
@@ -24,8 +23,6 @@ enum class Level { Debug, Info, Warn, Error };
 
 void write(Level, std::string message);
 void setMinLevel(Level);
-// The most recent lines (newest last), for the debug view and tests.
-std::vector<std::pair<Level, std::string>> recent(size_t maxLines = 200);
 
 template <class... A> void debug(A&&... a) { write(Level::Debug, str(std::forward<A>(a)...)); }
 template <class... A> void info(A&&... a) { write(Level::Info, str(std::forward<A>(a)...)); }

@@ -44,7 +44,6 @@ public:
     explicit ModuleLoader(std::vector<std::filesystem::path> dirs);
     ~ModuleLoader();
 
-    static bool isValidName(const std::string& name);
     static std::string fileNameFor(const std::string& name) { return "libpass_" + name + ".so"; }
 
     // Module names present in the directories, sorted.

@@ -90,7 +90,7 @@
 namespace kiln {
 
 // Bump when anything in this header (or what it includes) changes layout or vtables.
-inline constexpr uint32_t kPassAbiVersion = 1;
+inline constexpr uint32_t kPassAbiVersion = 2;
 
 struct TextureRef {
     GLuint id = 0;

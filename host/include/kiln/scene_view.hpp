@@ -1,6 +1,8 @@
-// kiln/scene_view.hpp — what a pass sees of the scene: camera, light, instances to
-// draw, and a version per category so the host can skip passes whose inputs did not
-// change. Built by the host once per frame from the simulation; read-only for passes.
+// kiln/scene_view.hpp — what a pass sees of the scene: the frame uniforms (camera,
+// lamp, output size, time), how many instances of each kind there are, and a version
+// per SceneCategory (kiln/declare.hpp) so the host can skip passes whose inputs did
+// not change. Built by the host once per frame, in one place (host/app/app.cpp);
+// read-only for passes.
 #pragma once
 
 #include <cstdint>
@@ -11,27 +13,17 @@
 
 namespace kiln {
 
-// What drawScene() can draw; a filter is a mask of these.
-enum DrawCategory : uint32_t {
-    kDrawBox = 1u << 0,        // the five walls (the floor carries the wood grain)
-    kDrawLamp = 1u << 1,       // the emissive hemisphere under the ceiling
-    kDrawTumblers = 1u << 2,
-    kDrawMarbles = 1u << 3,
-    kDrawFireballs = 1u << 4,
-    kDrawParticles = 1u << 5,
-    kDrawShadowCasters = kDrawTumblers | kDrawMarbles,  // fireballs emit, they don't cast
-    kDrawAll = 0x3f,
-};
-
 enum class Lod : uint8_t { High, Low };
 
+// What drawScene() draws: the geometry bits of SceneCategory (kSceneGeometry,
+// kSceneShadowCasters, kSceneTumblers | kSceneMarbles, ...) at a level of detail.
 struct DrawFilter {
-    uint32_t categories = kDrawAll;
+    uint32_t categories = kSceneGeometry;
     Lod lod = Lod::High;
 };
 
 // Per-instance data as the shaders see it (std430, binding kInstanceBinding); keep in
-// sync with shaders/common/scene.glsl.
+// sync with shaders/common/instances.glsl.
 struct alignas(16) GpuInstance {
     glm::mat4 model;
     glm::vec4 albedo;    // rgb, a = material (0 plain, 1 wood grain)
@@ -47,47 +39,35 @@ struct GpuFrame {
     glm::vec4 lightColor;    // rgb × intensity, w = intensity
     glm::vec4 outputSize;    // w, h, 1/w, 1/h
     glm::vec4 time;          // seconds, dt, frame index, unused
+    glm::vec4 woodLight;     // the floor's wood grain (scene file box.floor_wood):
+    glm::vec4 woodDark;      //   rgb light / dark, woodLight.w = rings per metre
 };
 
 inline constexpr unsigned kFrameBinding = 0;      // uniform block
 inline constexpr unsigned kInstanceBinding = 0;   // shader storage block
 
-int sceneCategoryIndex(SceneCategory);
-int drawCategoryIndex(DrawCategory);
+// Bit index of a single SceneCategory bit (kSceneTumblers → 2); -1 for a mask.
+constexpr int sceneCategoryIndex(uint32_t c) {
+    for (int i = 0; i < kSceneCategoryCount; ++i)
+        if (c == (1u << i)) return i;
+    return -1;
+}
 
 struct SceneView {
     GpuFrame frame{};
-    glm::vec3 cameraPos{0.0f};
-    glm::vec3 lightPos{0.0f, 1.1f, 0.0f};
-    float lampRadius = 0.35f;
-    glm::vec3 lightColor{1.0f};
+    // Bumped by the host whenever that category changed (geometry: its instance
+    // contents; light: the lamp; camera: the view-projection; time: a step).
+    uint64_t versions[kSceneCategoryCount] = {};
+    uint32_t counts[kSceneGeometryCount] = {};  // instances per geometry category
 
-    // Versions of each SceneCategory (declare.hpp): bumped by the host when that part
-    // changed. Index with sceneCategoryIndex().
-    uint64_t versions[6] = {};
-    uint32_t counts[6] = {};  // instances per DrawCategory bit index
-    // Bumped when that DrawCategory's instances changed (finer than kSceneBodies: the
-    // shadow map cares whether a caster moved, not whether a fireball did).
-    uint64_t drawVersions[6] = {};
-
-    uint64_t version(SceneCategory c) const;
-    uint32_t count(DrawCategory c) const;
-    uint64_t drawVersion(DrawCategory c) const { return drawVersions[drawCategoryIndex(c)]; }
+    uint64_t version(SceneCategory single) const { return versions[sceneCategoryIndex(single)]; }
+    // Instances in the geometry categories of `mask` (kSceneShadowCasters: tumblers + marbles).
+    uint32_t count(uint32_t mask) const {
+        uint32_t n = 0;
+        for (int i = 0; i < kSceneGeometryCount; ++i)
+            if (mask & (1u << i)) n += counts[i];
+        return n;
+    }
 };
-
-
-inline uint64_t SceneView::version(SceneCategory c) const { return versions[sceneCategoryIndex(c)]; }
-inline uint32_t SceneView::count(DrawCategory c) const { return counts[drawCategoryIndex(c)]; }
-
-inline int sceneCategoryIndex(SceneCategory c) {
-    for (int i = 0; i < 6; ++i)
-        if (c == (1u << i)) return i;
-    return 0;
-}
-inline int drawCategoryIndex(DrawCategory c) {
-    for (int i = 0; i < 6; ++i)
-        if (c == (1u << i)) return i;
-    return 0;
-}
 
 }  // namespace kiln

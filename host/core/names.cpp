@@ -1,9 +1,17 @@
-#include "graph/suggest.hpp"
+#include "kiln/names.hpp"
 
 #include <algorithm>
 #include <cctype>
 
-namespace kiln::graph {
+namespace kiln {
+
+bool isValidName(std::string_view s) {
+    if (s.empty() || s.size() > kMaxNameLength) return false;
+    for (char c : s)
+        if (!((c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_')) return false;
+    return true;
+}
+
 
 int editDistance(std::string_view a, std::string_view b) {
     const size_t n = a.size(), m = b.size();
@@ -55,4 +63,4 @@ std::string suggestion(std::string_view name, const std::vector<std::string>& ca
     return s + ")";
 }
 
-}  // namespace kiln::graph
+}  // namespace kiln

@@ -1,5 +1,5 @@
-// app/mesh.hpp — the scene's meshes, generated once on the CPU: a unit wall quad, the
-// icosphere lamp dome, the tumbler (round cone) and spheres, each in two levels of
+// scene/mesh.hpp — the scene's meshes, generated on the CPU on each scene load: a unit
+// wall quad, the icosphere lamp dome, the tumbler (round cone) and spheres, each in two levels of
 // detail. Indexed triangles; position + normal per vertex.
 #pragma once
 
@@ -8,7 +8,7 @@
 
 #include <glm/glm.hpp>
 
-namespace kiln::app {
+namespace kiln::scene {
 
 struct Vertex {
     glm::vec3 position;
@@ -31,4 +31,4 @@ MeshData makeUvSphere(int slices, int stacks);  // unit radius
 // (0, (b − t)/sin α, 0), joined by the tangent cone. `slices` around, `stacks` per cap.
 MeshData makeTumbler(float b, float t, float alpha, int slices, int stacks);
 
-}  // namespace kiln::app
+}  // namespace kiln::scene

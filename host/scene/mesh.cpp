@@ -1,10 +1,10 @@
-#include "app/mesh.hpp"
+#include "scene/mesh.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <map>
 
-namespace kiln::app {
+namespace kiln::scene {
 
 namespace {
 constexpr float kPi = 3.14159265358979f;
@@ -103,4 +103,4 @@ MeshData makeTumbler(float b, float t, float alpha, int slices, int stacks) {
     return m;
 }
 
-}  // namespace kiln::app
+}  // namespace kiln::scene

@@ -1,6 +1,7 @@
-// graph/suggest.hpp — "did you mean ...?" for misspelt names.
+// kiln/names.hpp — the one rule for pass ids and module names, and "did you mean ...?"
+// for misspelt names.
 //
-// Used for pass ids, module names, slots, outputs, parameters, enum choices and JSON
+// Suggestions are used for pass ids, module names, slots, outputs, parameters, enum choices and JSON
 // keys. The distance is Damerau–Levenshtein in its optimal-string-alignment form
 // (insert, delete, substitute, swap two neighbours: "sahdow" → "shadow" is 1).
 #pragma once
@@ -9,7 +10,13 @@
 #include <string_view>
 #include <vector>
 
-namespace kiln::graph {
+namespace kiln {
+
+// Pass ids and module names: [a-z0-9_], 1 to 64 characters (no path, "..", suffix).
+inline constexpr std::size_t kMaxNameLength = 64;
+inline constexpr const char* kNameRule = "[a-z0-9_]+ (at most 64 characters)";
+bool isValidName(std::string_view s);
+
 
 // Edit distance with adjacent transpositions, case-insensitive.
 int editDistance(std::string_view a, std::string_view b);
@@ -23,4 +30,4 @@ std::string nearestName(std::string_view name, const std::vector<std::string>& c
 std::string suggestion(std::string_view name, const std::vector<std::string>& candidates,
                        std::string_view what = "available");
 
-}  // namespace kiln::graph
+}  // namespace kiln

@@ -1,0 +1,356 @@
+#include "run/runtime.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <fstream>
+#include <sstream>
+
+#include "kiln/log.hpp"
+
+namespace fs = std::filesystem;
+
+namespace kiln::run {
+
+namespace {
+// Units the host unbinds before each pass: more than any shipped pass uses; GL 4.5
+// guarantees 80 texture and 8 image units.
+constexpr GLsizei kResetTextureUnits = 16;
+constexpr GLsizei kResetImageUnits = 8;
+}  // namespace
+
+Runtime::Runtime() = default;
+Runtime::~Runtime() {
+    // Pass objects go before the modules whose code destroys them (PassPtr keeps its
+    // module alive), and before the GL objects they might reference.
+    slots_.clear();
+    if (modules_) modules_->clear();
+}
+
+bool Runtime::init(const RuntimeOptions& options, std::string& error) {
+    options_ = options;
+    modules_ = std::make_unique<ModuleRegistry>(options.moduleDirs);
+    shaders_ = std::make_unique<ShaderLibrary>(options.shaderRoots);
+    if (shaders_->resolve("common/frame.glsl").empty()) {
+        error = "shader root without common/frame.glsl; looked in: ";
+        for (auto& r : options.shaderRoots) error += r.string() + " ";
+        return false;
+    }
+    frameUniforms_ = gl::Buffer::create(sizeof(GpuFrame), nullptr, GL_DYNAMIC_STORAGE_BIT, "kiln.frame");
+    GLuint vao = 0;
+    glCreateVertexArrays(1, &vao);
+    emptyVao_ = gl::VertexArrayHandle(vao);
+    fallbacks_.create();
+    return true;
+}
+
+bool Runtime::loadPipeline(const fs::path& file, std::string& errors) {
+    std::ifstream in(file, std::ios::binary);
+    if (!in) {
+        errors = file.string() + ": cannot read pipeline file";
+        return false;
+    }
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return loadPipelineText(ss.str(), file.string(), errors);
+}
+
+bool Runtime::loadPipelineText(const std::string& text, const std::string& displayName, std::string& errors) {
+    graph::CompileOptions opt;
+    opt.resolve = [this](const std::string& m) { return modules_->declaration(m); };
+    opt.availableModules = modules_->loader().available();
+    opt.requested = requested_;
+    auto result = graph::compileText(text, displayName, opt);
+    if (!result) {
+        errors = result.errorText();
+        return false;
+    }
+    for (auto& w : result->warnings) log::warn(w.str());
+    pipelineText_ = text;
+    pipelineFile_ = displayName;
+    adoptPlan(std::move(*result));
+    return true;
+}
+
+void Runtime::setRequested(std::vector<std::string> requested) {
+    if (requested == requested_) return;
+    requested_ = std::move(requested);
+    recompilePlan();
+}
+
+void Runtime::recompilePlan() {
+    if (pipelineText_.empty()) return;
+    std::string errors;
+    if (!loadPipelineText(pipelineText_, pipelineFile_, errors)) log::error(errors);
+}
+
+void Runtime::adoptPlan(graph::Plan plan) {
+    const graph::PlanDiff diff = plan_ ? graph::diffPlans(*plan_, plan) : graph::PlanDiff{};
+    std::map<std::string, std::unique_ptr<PassSlot>> old;
+    for (auto& s : slots_) old[s->id] = std::move(s);
+    std::vector<std::unique_ptr<PassSlot>> next;
+    for (auto& planned : plan.passes) {
+        auto it = old.find(planned.id);
+        std::unique_ptr<PassSlot> previous;
+        if (it != old.end()) previous = std::move(it->second);
+        next.push_back(reuseOrCreateSlot(planned, std::move(previous), diff.isUnchanged(planned.id)));
+    }
+    slots_ = std::move(next);
+    plan_ = std::move(plan);
+    for (size_t i = 0; i < slots_.size(); ++i) allocateTextures(i);
+    log::info("pipeline ", plan_->fileName, ": ", plan_->runOrder().size(), " of ", plan_->passes.size(),
+              " passes run; ", diff.unchanged.size(), " unchanged, ", diff.changed.size(),
+              " changed in module, parameters or inputs");
+}
+
+// A pass whose id and signature (module, parameters, inputs) are unchanged keeps
+// everything: object, textures, programs, skip state. One of the same module whose
+// parameters or inputs changed keeps its textures where their shape is the same
+// (allocateTextures decides) and its programs, but gets a fresh object and runs again.
+// Anything else starts fresh.
+std::unique_ptr<PassSlot> Runtime::reuseOrCreateSlot(const graph::PlannedPass& planned,
+                                                     std::unique_ptr<PassSlot> slot, bool unchanged) {
+    if (!slot || slot->module != planned.module) {
+        slot = std::make_unique<PassSlot>();
+        slot->id = planned.id;
+        slot->module = planned.module;
+    } else if (!unchanged) {
+        slot->pass.reset();  // its cached decisions were made for other parameters
+        slot->error.clear();
+    }
+    slot->signature = planned.signatureHash;
+    if (planned.state == graph::PassState::Disabled) {
+        slot->textures.clear();
+        slot->framebuffers.clear();
+    } else if (!slot->pass) {
+        createPassObject(*slot, planned);
+    }
+    return slot;
+}
+
+void Runtime::createPassObject(PassSlot& slot, const graph::PlannedPass& planned) {
+    const ModuleRegistry::Module* module = modules_->find(planned.module);
+    std::string error = "module " + planned.module + " is not loaded";
+    slot.pass.reset();
+    if (module) {
+        slot.library = module->library;
+        slot.pass = ModuleLoader::create(module->library, error);
+    }
+    if (!slot.pass) slot.error = error;
+    slot.invalidate(false);
+}
+
+void Runtime::allocateTextures(size_t i) {
+    const graph::PlannedPass& planned = plan_->passes[i];
+    PassSlot& slot = *slots_[i];
+    if (planned.state == graph::PassState::Disabled) return;
+    bool changed = false;
+    auto want = [&](const TextureDecl& d, bool internal) {
+        const graph::Extent e = plan_->extentOf(static_cast<int>(i), d.name, options_.width, options_.height);
+        changed |= ensureTexture(slot.textures, d, e, internal, slot.id + "." + d.name, ++versionCounter_);
+    };
+    for (auto& d : planned.decl.outputs) want(d, false);
+    for (auto& d : planned.decl.internals) want(d, true);
+    // Textures the declaration no longer has (a reloaded module renamed one) go.
+    changed |= std::erase_if(slot.textures, [&](auto& entry) { return !planned.texture(entry.first); }) > 0;
+    if (changed) slot.invalidate(true);
+}
+
+void Runtime::resize(int width, int height) {
+    if (width == options_.width && height == options_.height) return;
+    options_.width = std::max(1, width);
+    options_.height = std::max(1, height);
+    if (!plan_) return;
+    // In order: a texture sized from an input follows its producer's new size.
+    for (size_t i = 0; i < slots_.size(); ++i) allocateTextures(i);
+}
+
+std::vector<uint64_t> Runtime::runKey(const graph::PlannedPass& planned, const PassSlot& slot,
+                                      const SceneView& view) const {
+    // Everything whose change must make the pass run again: each input's version
+    // (0 for a fallback), each scene category it reads, the output size, and the
+    // generation of its programs (a rebuilt program runs the pass again).
+    std::vector<uint64_t> key;
+    for (auto& b : planned.bindings) {
+        uint64_t version = 0;
+        if (b.bound()) {
+            const PassSlot& producer = *slots_[static_cast<size_t>(b.producer)];
+            auto it = producer.textures.find(b.output);
+            if (it != producer.textures.end()) version = it->second.version;
+        }
+        key.push_back(version);
+    }
+    for (int i = 0; i < kSceneCategoryCount; ++i)
+        key.push_back((planned.decl.reads & (1u << i)) ? view.versions[i] : 0);
+    key.push_back(static_cast<uint64_t>(options_.width) << 32 | static_cast<uint32_t>(options_.height));
+    key.push_back(slot.programs.generation());
+    return key;
+}
+
+void Runtime::renderFrame(const SceneView& view, const SceneDraw& scene, const FrameInfo& frameIn) {
+    FrameInfo frame = frameIn;
+    frame.outputWidth = options_.width;
+    frame.outputHeight = options_.height;
+    GpuFrame gpuFrame = view.frame;
+    gpuFrame.outputSize = {float(options_.width), float(options_.height), 1.0f / float(options_.width),
+                           1.0f / float(options_.height)};
+    gpuFrame.time = {float(frame.time), float(frame.dt), float(frame.index), 0.0f};
+    glNamedBufferSubData(frameUniforms_.id(), 0, sizeof(GpuFrame), &gpuFrame);
+    collectGpuTimes();
+    if (!plan_) return;
+    const FrameResources shared{slots_, fallbacks_, *shaders_, scene, emptyVao_.id()};
+    for (size_t i = 0; i < slots_.size(); ++i) runPass(i, shared, view, frame);
+}
+
+void Runtime::runPass(size_t i, const FrameResources& shared, const SceneView& view, const FrameInfo& frame) {
+    PassSlot& slot = *slots_[i];
+    const graph::PlannedPass& planned = plan_->passes[i];
+    PassTimings& t = slot.timings;
+    if (planned.state != graph::PassState::Run) return t.note(graph::toString(planned.state), planned.reason);
+    if (!slot.pass) return t.note("error", slot.error);
+    const auto key = runKey(planned, slot, view);
+    if (!alwaysRun && !planned.decl.timeDependent && slot.lastRunKey == key && slot.error.empty()) {
+        ++t.skippedFrames;
+        return t.note("skipped", "inputs, parameters and scene unchanged");
+    }
+
+    resetGlState();
+    slot.error.clear();
+    HostPassContext ctx(shared, slot, planned, view, frame);
+    const auto cpuStart = std::chrono::steady_clock::now();
+    {
+        gl::DebugGroup group(slot.id);
+        t.timer.begin();
+        try {
+            slot.pass->execute(ctx);
+        } catch (const std::exception& e) {
+            ctx.fail(str("execute() threw: ", e.what()));
+        }
+        t.timer.end();
+    }
+    t.addCpu(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - cpuStart).count());
+
+    if (ctx.failed()) {
+        slot.lastRunKey.reset();
+        return t.note("error", slot.error);
+    }
+    ++t.ranFrames;
+    slot.lastRunKey = runKey(planned, slot, view);
+    if (ctx.nothing()) return t.note("nothing to do", *ctx.nothing());
+    t.note("ran", "");
+    for (auto& [name, tex] : slot.textures) tex.version = ++versionCounter_;
+}
+
+// A clean slate for every pass, so one pass's GL state never leaks into the next
+// (the list is the pass manual's, kiln/pass.hpp "GL STATE").
+void Runtime::resetGlState() const {
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glViewport(0, 0, options_.width, options_.height);
+    glDisable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDepthMask(GL_TRUE);
+    glDisable(GL_BLEND);
+    glBlendFunc(GL_ONE, GL_ZERO);
+    glDisable(GL_CULL_FACE);
+    glCullFace(GL_BACK);
+    glDisable(GL_POLYGON_OFFSET_FILL);
+    glPolygonOffset(0.0f, 0.0f);
+    glDisable(GL_SCISSOR_TEST);
+    glDisable(GL_STENCIL_TEST);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glUseProgram(0);
+    glBindVertexArray(0);
+    glBindTextures(0, kResetTextureUnits, nullptr);
+    glBindImageTextures(0, kResetImageUnits, nullptr);
+    glBindBufferBase(GL_UNIFORM_BUFFER, kFrameBinding, frameUniforms_.id());
+}
+
+void Runtime::collectGpuTimes() {
+    for (auto& s : slots_) s->timings.collectGpu();
+}
+
+void Runtime::resetTimings() {
+    for (auto& s : slots_) s->timings.reset();
+}
+
+const TextureRef* Runtime::outputTexture() const {
+    if (!plan_ || !plan_->output.valid()) return nullptr;
+    const PassSlot& slot = *slots_[static_cast<size_t>(plan_->output.pass)];
+    auto it = slot.textures.find(plan_->output.name);
+    return it == slot.textures.end() ? nullptr : &it->second.ref;
+}
+
+const TextureRef* Runtime::findTexture(std::string_view pass, std::string_view name) const {
+    for (auto& s : slots_) {
+        if (s->id != pass) continue;
+        auto it = s->textures.find(name);
+        return it == s->textures.end() ? nullptr : &it->second.ref;
+    }
+    return nullptr;
+}
+
+std::vector<PassRow> Runtime::stats() const {
+    std::vector<PassRow> rows;
+    for (auto& s : slots_) rows.push_back(s->timings.row(s->id, s->module));
+    return rows;
+}
+
+std::vector<NamedTexture> Runtime::textures() const {
+    std::vector<NamedTexture> out;
+    for (auto& s : slots_)
+        for (auto& [name, t] : s->textures) out.push_back({s->id, name, t.internal, t.ref});
+    return out;
+}
+
+std::vector<std::string> Runtime::activeErrors() const {
+    std::vector<std::string> errors;
+    for (auto& [key, message] : externalErrors_) errors.push_back(message);
+    for (auto& s : slots_) {
+        if (!s->error.empty()) errors.push_back(s->id + ": " + s->error);
+        for (auto& e : s->programs.standingErrors()) errors.push_back(s->id + ": " + e);
+    }
+    return errors;
+}
+
+void Runtime::setExternalError(const std::string& key, const std::string& message) {
+    if (message.empty()) externalErrors_.erase(key);
+    else externalErrors_[key] = message;
+}
+
+int Runtime::reloadShaders(const std::vector<fs::path>& changed) {
+    int rebuilt = 0;
+    for (auto& slot : slots_) {
+        const int n = slot->programs.reload(*shaders_, changed);
+        if (n > 0) slot->error.clear();
+        rebuilt += n;
+    }
+    return rebuilt;
+}
+
+bool Runtime::reloadModule(const std::string& name, std::string& error) {
+    auto probed = modules_->probe(name);
+    if (!probed) {
+        error = probed.errorText();
+        if (!error.empty() && error.back() == '\n') error.pop_back();
+        return false;
+    }
+    // Validate the pipeline against the new declaration before touching anything.
+    std::optional<ModuleRegistry::Module> old;
+    if (const ModuleRegistry::Module* m = modules_->find(name)) old = *m;
+    modules_->set(name, *probed);
+    std::string errors;
+    if (!pipelineText_.empty() && !loadPipelineText(pipelineText_, pipelineFile_, errors)) {
+        if (old) modules_->set(name, *old);
+        else modules_->erase(name);
+        error = errors;
+        return false;
+    }
+    old.reset();
+    // Objects of the old library go first (their code lives there); their slots keep
+    // textures and parameters, and get an object of the new library.
+    for (size_t i = 0; i < slots_.size(); ++i)
+        if (slots_[i]->module == name && plan_->passes[i].state != graph::PassState::Disabled)
+            createPassObject(*slots_[i], plan_->passes[i]);
+    return true;
+}
+
+}  // namespace kiln::run

@@ -1,0 +1,109 @@
+// run/runtime.hpp — runs a compiled plan: adopts a new plan at a frame boundary
+// (keeping what did not change), renders a frame, and decides per pass whether it
+// runs or is skipped.
+//
+// Compile → cull → execute are three visible stages: the graph compiler (host/graph)
+// produces a Plan; loadPipeline() swaps it in, keeping the pass objects and textures of
+// passes whose signature did not change; renderFrame() executes the passes that run,
+// skipping those whose inputs, parameters and scene categories are all unchanged since
+// their last run. What it keeps per pass is a PassSlot (run/pass_slot.hpp).
+#pragma once
+
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "graph/compiler.hpp"
+#include "run/module_registry.hpp"
+#include "run/pass_context.hpp"
+#include "run/pass_slot.hpp"
+
+namespace kiln::run {
+
+struct RuntimeOptions {
+    std::vector<std::filesystem::path> shaderRoots;
+    std::vector<std::filesystem::path> moduleDirs;
+    int width = 720, height = 720;
+};
+
+class Runtime {
+public:
+    Runtime();
+    ~Runtime();
+
+    bool init(const RuntimeOptions&, std::string& error);
+
+    // Compiles `file` and, on success, swaps the new plan in. On failure the running
+    // plan stays and `errors` holds every diagnostic (with JSON paths).
+    bool loadPipeline(const std::filesystem::path& file, std::string& errors);
+    bool loadPipelineText(const std::string& text, const std::string& displayName, std::string& errors);
+    // Textures the debug view shows or --dump wants ("pass.output"): un-culls their
+    // producers without touching anyone's textures.
+    void setRequested(std::vector<std::string> requested);
+    void resize(int width, int height);
+
+    void renderFrame(const SceneView& view, const SceneDraw& scene, const FrameInfo& frame);
+    // Harvests finished GPU timer queries (renderFrame does it each frame; call after
+    // a glFinish to get the last frames' times too).
+    void collectGpuTimes();
+    // Forgets every timing sample and ran/skipped count (benchmarks call it after warm-up).
+    void resetTimings();
+    // Runs every pass every frame regardless of versions (timing runs).
+    bool alwaysRun = false;
+
+    // The graph output of the last frame (a colour 2D texture), or null.
+    const TextureRef* outputTexture() const;
+    const TextureRef* findTexture(std::string_view pass, std::string_view name) const;
+    const graph::Plan* plan() const { return plan_ ? &*plan_ : nullptr; }
+    const std::string& pipelineFile() const { return pipelineFile_; }
+    const std::string& pipelineText() const { return pipelineText_; }
+    std::vector<PassRow> stats() const;
+    std::string statsTable() const { return formatStatsTable(stats()); }
+    std::vector<NamedTexture> textures() const;
+    bool dump(const std::filesystem::path& dir, std::string& error) const { return dumpTextures(textures(), dir, error); }
+
+    // Live reload. Rebuilds every program that read one of `changedFiles` (absolute
+    // paths); a failed build keeps the last good program and reports the mapped
+    // error. Returns how many programs were rebuilt successfully.
+    int reloadShaders(const std::vector<std::filesystem::path>& changedFiles);
+    // Loads a fresh copy of module `name`; on success every pass of that module gets a
+    // new object from it (parameters and textures kept) and the old library goes.
+    bool reloadModule(const std::string& name, std::string& error);
+    bool usesModule(const std::string& name) const { return modules_ && modules_->uses(name); }
+    // Errors from reloads outside the graph (scene file, module), shown until cleared.
+    void setExternalError(const std::string& key, const std::string& message);
+
+    ModuleLoader& loader() { return modules_->loader(); }
+    const ShaderLibrary& shaders() const { return *shaders_; }
+    // Errors currently standing (shader compile, pass failures), for the overlay.
+    std::vector<std::string> activeErrors() const;
+
+private:
+    void adoptPlan(graph::Plan plan);
+    std::unique_ptr<PassSlot> reuseOrCreateSlot(const graph::PlannedPass&, std::unique_ptr<PassSlot> old,
+                                                 bool unchanged);
+    void createPassObject(PassSlot&, const graph::PlannedPass&);
+    void allocateTextures(size_t pass);
+    std::vector<uint64_t> runKey(const graph::PlannedPass&, const PassSlot&, const SceneView&) const;
+    void runPass(size_t pass, const FrameResources&, const SceneView&, const FrameInfo&);
+    void resetGlState() const;
+    void recompilePlan();
+
+    RuntimeOptions options_;
+    std::unique_ptr<ModuleRegistry> modules_;
+    std::unique_ptr<ShaderLibrary> shaders_;
+    std::optional<graph::Plan> plan_;
+    std::string pipelineText_, pipelineFile_;
+    std::vector<std::string> requested_;
+    std::vector<std::unique_ptr<PassSlot>> slots_;  // parallel to plan_->passes
+    gl::Buffer frameUniforms_;
+    gl::VertexArrayHandle emptyVao_;
+    FallbackTextures fallbacks_;
+    uint64_t versionCounter_ = 0;
+    std::map<std::string, std::string> externalErrors_;
+};
+
+}  // namespace kiln::run

@@ -1,0 +1,63 @@
+// run/texture_pool.hpp — the textures the host owns for the passes: allocation by
+// declaration and extent (kept when the shape is unchanged, so a recompile or a resize
+// keeps contents), the fallback textures unbound optional inputs read, the mapping
+// from declared formats to GL, and writing them all to disk (--dump).
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "graph/plan.hpp"
+#include "kiln/gl.hpp"
+#include "kiln/pass.hpp"
+
+namespace kiln::run {
+
+GLenum glFormat(Format);
+bool isFloatFormat(GLenum internalFormat);
+
+struct PooledTexture {
+    TextureDecl decl;
+    gl::Texture texture;
+    TextureRef ref;
+    uint64_t version = 0;  // changes whenever its producer writes it (or it is new)
+    bool internal = false;
+};
+// One pass's outputs and internal textures, by declared name.
+using PassTextures = std::map<std::string, PooledTexture, std::less<>>;
+
+// Makes `textures[decl.name]` a texture of `decl`'s format, kind and mip count at
+// `extent`. One of the same shape is kept with its contents; otherwise a new one is
+// created, cleared (colour 0, depth 1), labelled `label`, and given version
+// `newVersion`. Returns true when it created one.
+bool ensureTexture(PassTextures& textures, const TextureDecl& decl, graph::Extent extent, bool internal,
+                   const std::string& label, uint64_t newVersion);
+
+// What an unbound optional input reads: 1×1 black / white / flat normal / far depth
+// (2D) and a black 1³ volume (3D).
+class FallbackTextures {
+public:
+    void create();
+    const TextureRef& get(TextureKind, Fallback) const;
+
+private:
+    enum { kBlack, kWhite, kFlatNormal, kFarDepth, kBlack3D, kCount };
+    gl::Texture textures_[kCount];
+    TextureRef refs_[kCount];
+};
+
+struct NamedTexture {
+    std::string pass, name;
+    bool internal;
+    TextureRef ref;
+};
+
+// Writes each texture into `dir` as PASS.NAME.png (clamped to [0,1]) and, for float
+// and depth formats, PASS.NAME.pfm with the raw values. 3D textures: the middle slice
+// of level 0.
+bool dumpTextures(const std::vector<NamedTexture>&, const std::filesystem::path& dir, std::string& error);
+
+}  // namespace kiln::run

@@ -1,0 +1,87 @@
+#include "scene/live_scene.hpp"
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/type_ptr.hpp>
+
+namespace kiln::scene {
+
+namespace {
+
+SceneLook lookOf(const sim::Scene& scene) {
+    SceneLook look;
+    look.left = glm::vec3(scene.box.left);
+    look.right = glm::vec3(scene.box.right);
+    look.other = glm::vec3(scene.box.other);
+    look.woodLight = glm::vec3(scene.box.floorWood.light);
+    look.woodDark = glm::vec3(scene.box.floorWood.dark);
+    look.woodRingFrequency = float(scene.box.floorWood.ringFrequency);
+    look.lampCentre = glm::vec3(scene.lamp.center);
+    look.lampRadius = float(scene.lamp.radius);
+    look.lampColor = glm::vec3(scene.lamp.color);
+    look.lampIntensity = float(scene.lamp.intensity);
+    look.tumblerB = float(scene.tumblerShape.b);
+    look.tumblerT = float(scene.tumblerShape.t);
+    look.tumblerAlpha = float(scene.tumblerShape.alpha);
+    return look;
+}
+
+std::vector<BodyInstance> bodiesOf(const sim::World& world, int highlighted) {
+    std::vector<BodyInstance> bodies;
+    for (size_t i = 0; i < world.tumblers().size(); ++i) {
+        const auto& t = world.tumblers()[i];
+        BodyInstance b;
+        b.category = kSceneTumblers;
+        float m[16];
+        t.modelMatrix(m);
+        b.model = glm::make_mat4(m);
+        b.albedo = glm::vec3(t.color);
+        b.highlighted = int(i) == highlighted;
+        bodies.push_back(b);
+    }
+    for (const auto& ball : world.balls()) {
+        // The sim owns the look of a ball (burning marbles darken towards ash).
+        BodyInstance b;
+        b.category = ball.kind == sim::BallKind::Fireball ? kSceneFireballs : kSceneMarbles;
+        b.model = glm::scale(glm::translate(glm::mat4(1.0f), glm::vec3(ball.position)), glm::vec3(float(ball.radius)));
+        b.albedo = glm::vec3(ball.albedo());
+        b.emissive = glm::vec3(ball.emissiveColor() * ball.emissiveStrength());
+        bodies.push_back(b);
+    }
+    return bodies;
+}
+
+}  // namespace
+
+bool LiveScene::load(const std::string& sceneFile, std::optional<uint64_t> seed, std::string& error) {
+    sim::Scene scene;
+    if (!sim::loadScene(sceneFile, scene, error)) return false;
+    if (seed) scene.physics.seed = *seed;
+    sim_.reset(scene);
+    file_ = sceneFile;
+    look_ = lookOf(scene);
+    ++generation_;
+    return true;
+}
+
+void LiveScene::writeTo(SceneRenderer& renderer, int highlighted) {
+    if (sentGeneration_ != generation_) {
+        renderer.setLook(look_);
+        sentGeneration_ = generation_;
+        sentBodies_ = sentParticles_ = ~0ull;
+    }
+    if (sim_.bodiesVersion() != sentBodies_ || highlighted != sentHighlight_) {
+        renderer.setBodies(bodiesOf(sim_, highlighted));
+        sentBodies_ = sim_.bodiesVersion();
+        sentHighlight_ = highlighted;
+    }
+    if (sim_.particlesVersion() != sentParticles_) {
+        std::vector<ParticleInstance> particles;
+        particles.reserve(sim_.particles().size());
+        for (const auto& p : sim_.particles())
+            particles.push_back({glm::vec3(p.position), float(p.radius()), glm::vec3(p.emission())});
+        renderer.setParticles(particles);
+        sentParticles_ = sim_.particlesVersion();
+    }
+}
+
+}  // namespace kiln::scene

@@ -1,0 +1,47 @@
+// scene/live_scene.hpp — the scene as Kiln runs it: the simulation (libkiln_sim's
+// sim::World) loaded from a scene file, plus how that file says it looks. It steps the
+// world and hands what changed to the scene renderer; data flows one way, from here to
+// the renderer, and the app builds the SceneView from both (host/app/app.cpp).
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "kiln/sim/world.hpp"
+#include "scene/scene_renderer.hpp"
+
+namespace kiln::scene {
+
+class LiveScene {
+public:
+    // Loads `sceneFile` (with `seed` instead of the file's physics.seed when given);
+    // on failure keeps the current world and returns false with a one-line error.
+    bool load(const std::string& sceneFile, std::optional<uint64_t> seed, std::string& error);
+    void step() { sim_.step(); }
+    void reset() { sim_.reset(); }
+    double time() const { return sim_.time(); }
+    double dt() const { return sim_.scene().physics.dt; }
+    sim::World& sim() { return sim_; }
+    const sim::World& sim() const { return sim_; }
+    const SceneLook& look() const { return look_; }
+    const std::string& file() const { return file_; }
+    // Bumped by every successful load: the lamp and the meshes may have changed.
+    uint64_t generation() const { return generation_; }
+
+    // Pushes what changed since the last call into `renderer`: on a new generation the
+    // look (meshes, walls, lamp), then bodies and particles whose sim versions moved.
+    // `highlighted` is the picked tumbler (or −1).
+    void writeTo(SceneRenderer& renderer, int highlighted);
+
+private:
+    sim::World sim_;
+    SceneLook look_;
+    std::string file_;
+    uint64_t generation_ = 0;
+    // What the renderer last got.
+    uint64_t sentGeneration_ = 0, sentBodies_ = ~0ull, sentParticles_ = ~0ull;
+    int sentHighlight_ = -2;
+};
+
+}  // namespace kiln::scene

@@ -1,0 +1,166 @@
+#include "scene/scene_renderer.hpp"
+
+#include <algorithm>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "kiln/hash.hpp"
+#include "scene/mesh.hpp"
+
+namespace kiln::scene {
+
+void SceneRenderer::buildMeshes(const SceneLook& look) {
+    std::array<MeshData, kMeshCount> data = {
+        makeQuad(),
+        makeLampDome(look.lampCentre, look.lampRadius, 3, 1.0f),
+        makeTumbler(look.tumblerB, look.tumblerT, look.tumblerAlpha, 48, 16),
+        makeTumbler(look.tumblerB, look.tumblerT, look.tumblerAlpha, 12, 4),
+        makeUvSphere(32, 16),
+        makeUvSphere(10, 6),
+    };
+    std::vector<Vertex> vertices;
+    std::vector<uint32_t> indices;
+    for (int i = 0; i < kMeshCount; ++i) {
+        meshes_[i] = {static_cast<uint32_t>(indices.size()), static_cast<uint32_t>(data[i].indices.size()),
+                      static_cast<uint32_t>(vertices.size())};
+        vertices.insert(vertices.end(), data[i].vertices.begin(), data[i].vertices.end());
+        indices.insert(indices.end(), data[i].indices.begin(), data[i].indices.end());
+    }
+    vertexBuffer_ = gl::Buffer::create(static_cast<GLsizeiptr>(vertices.size() * sizeof(Vertex)), vertices.data(), 0,
+                                       "scene.vertices");
+    indexBuffer_ = gl::Buffer::create(static_cast<GLsizeiptr>(indices.size() * sizeof(uint32_t)), indices.data(), 0,
+                                      "scene.indices");
+    if (!vao_) {
+        GLuint vao = 0;
+        glCreateVertexArrays(1, &vao);
+        vao_ = gl::VertexArrayHandle(vao);
+        gl::label(GL_VERTEX_ARRAY, vao, "scene.vao");
+        glEnableVertexArrayAttrib(vao, 0);
+        glEnableVertexArrayAttrib(vao, 1);
+        glVertexArrayAttribFormat(vao, 0, 3, GL_FLOAT, GL_FALSE, offsetof(Vertex, position));
+        glVertexArrayAttribFormat(vao, 1, 3, GL_FLOAT, GL_FALSE, offsetof(Vertex, normal));
+        glVertexArrayAttribBinding(vao, 0, 0);
+        glVertexArrayAttribBinding(vao, 1, 0);
+        glEnableVertexArrayAttrib(vao, 2);
+        glVertexArrayAttribIFormat(vao, 2, 1, GL_UNSIGNED_INT, 0);
+        glVertexArrayAttribBinding(vao, 2, 1);
+        glVertexArrayBindingDivisor(vao, 1, 1);
+    }
+    glVertexArrayVertexBuffer(vao_.id(), 0, vertexBuffer_.id(), 0, sizeof(Vertex));
+    glVertexArrayElementBuffer(vao_.id(), indexBuffer_.id());
+}
+
+void SceneRenderer::setLook(const SceneLook& look) {
+    buildMeshes(look);
+    staticInstances_.clear();
+    auto wall = [&](glm::mat4 m, glm::vec3 albedo, float material) {
+        staticInstances_.push_back({m, glm::vec4(albedo, material), glm::vec4(0.0f)});
+    };
+    // The quad faces +y at y = 0; each wall is it rotated so its normal points into the room.
+    const glm::mat4 I(1.0f);
+    wall(glm::translate(I, {0, -1, 0}), look.woodLight, 1.0f);                                           // floor
+    wall(glm::rotate(glm::translate(I, {0, 1, 0}), glm::radians(180.0f), {1, 0, 0}), look.other, 0.0f);  // ceiling
+    wall(glm::rotate(glm::translate(I, {-1, 0, 0}), glm::radians(-90.0f), {0, 0, 1}), look.left, 0.0f);  // left
+    wall(glm::rotate(glm::translate(I, {1, 0, 0}), glm::radians(90.0f), {0, 0, 1}), look.right, 0.0f);   // right
+    wall(glm::rotate(glm::translate(I, {0, 0, -1}), glm::radians(90.0f), {1, 0, 0}), look.other, 0.0f);  // back
+    // The lamp dome: its mesh is already in world space.
+    staticInstances_.push_back(
+        {I, glm::vec4(look.lampColor, 0.0f), glm::vec4(look.lampColor * look.lampIntensity, 0.0f)});
+    // New meshes change what every category looks like, whatever its instances say.
+    for (int i = 0; i < kSceneGeometryCount; ++i) ++versions_[i], hashes_[i] = 0;
+    noteContents(kSceneBox, staticInstances_.data(), 5);
+    noteContents(kSceneLamp, staticInstances_.data() + 5, 1);
+    dirty_ = true;
+}
+
+void SceneRenderer::noteContents(SceneCategory c, const GpuInstance* begin, size_t count) {
+    const uint64_t h = fnv1a(begin, count * sizeof(GpuInstance), fnv1a(&count, sizeof count));
+    const int k = sceneCategoryIndex(c);
+    counts_[k] = static_cast<uint32_t>(count);
+    if (h != hashes_[k]) hashes_[k] = h, ++versions_[k];
+}
+
+void SceneRenderer::setBodies(const std::vector<BodyInstance>& bodies) {
+    // Grouped by category so each category is one contiguous instance range.
+    bodyInstances_.clear();
+    for (SceneCategory c : {kSceneTumblers, kSceneMarbles, kSceneFireballs}) {
+        const size_t first = bodyInstances_.size();
+        for (auto& b : bodies)
+            if (b.category == c)
+                bodyInstances_.push_back(
+                    {b.model, glm::vec4(b.albedo, 0.0f), glm::vec4(b.emissive, b.highlighted ? 1.0f : 0.0f)});
+        noteContents(c, bodyInstances_.data() + first, bodyInstances_.size() - first);
+    }
+    dirty_ = true;
+}
+
+void SceneRenderer::setParticles(const std::vector<ParticleInstance>& particles) {
+    particleInstances_.clear();
+    for (auto& p : particles) {
+        glm::mat4 m = glm::scale(glm::translate(glm::mat4(1.0f), p.position), glm::vec3(p.radius));
+        particleInstances_.push_back({m, glm::vec4(0.0f), glm::vec4(p.emissive, 0.0f)});
+    }
+    noteContents(kSceneParticles, particleInstances_.data(), particleInstances_.size());
+    dirty_ = true;
+}
+
+void SceneRenderer::rebuildGroups() {
+    groups_.clear();
+    uint32_t cursor = 0;
+    auto add = [&](MeshId mesh, MeshId lowMesh, SceneCategory cat) {
+        const uint32_t n = count(cat);
+        if (n == 0) return;
+        groups_.push_back({mesh, cat, Lod::High, mesh == lowMesh, cursor, n});
+        if (mesh != lowMesh) groups_.push_back({lowMesh, cat, Lod::Low, false, cursor, n});
+        cursor += n;
+    };
+    // The order of the instance buffer: static, bodies by category, particles.
+    add(kQuad, kQuad, kSceneBox);
+    add(kLamp, kLamp, kSceneLamp);
+    add(kTumblerHigh, kTumblerLow, kSceneTumblers);
+    add(kSphereHigh, kSphereLow, kSceneMarbles);
+    add(kSphereHigh, kSphereLow, kSceneFireballs);
+    add(kSphereLow, kSphereLow, kSceneParticles);
+}
+
+void SceneRenderer::upload() {
+    if (!dirty_) return;
+    rebuildGroups();
+    std::vector<GpuInstance> all;
+    all.reserve(staticInstances_.size() + bodyInstances_.size() + particleInstances_.size());
+    all.insert(all.end(), staticInstances_.begin(), staticInstances_.end());
+    all.insert(all.end(), bodyInstances_.begin(), bodyInstances_.end());
+    all.insert(all.end(), particleInstances_.begin(), particleInstances_.end());
+    if (all.size() > instanceCapacity_) {
+        instanceCapacity_ = std::max<size_t>(all.size() * 2, 256);
+        instanceBuffer_ = gl::Buffer::create(static_cast<GLsizeiptr>(instanceCapacity_ * sizeof(GpuInstance)), nullptr,
+                                             GL_DYNAMIC_STORAGE_BIT, "scene.instances");
+        std::vector<uint32_t> ids(instanceCapacity_);
+        for (size_t i = 0; i < ids.size(); ++i) ids[i] = static_cast<uint32_t>(i);
+        instanceIds_ = gl::Buffer::create(static_cast<GLsizeiptr>(ids.size() * sizeof(uint32_t)), ids.data(), 0,
+                                          "scene.instance_ids");
+        glVertexArrayVertexBuffer(vao_.id(), 1, instanceIds_.id(), 0, sizeof(uint32_t));
+    }
+    glNamedBufferSubData(instanceBuffer_.id(), 0, static_cast<GLsizeiptr>(all.size() * sizeof(GpuInstance)), all.data());
+    dirty_ = false;
+}
+
+void SceneRenderer::draw(const DrawFilter& filter) const {
+    if (!instanceBuffer_) return;
+    glBindVertexArray(vao_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kInstanceBinding, instanceBuffer_.id());
+    for (auto& g : groups_) {
+        if (!(filter.categories & g.category)) continue;
+        if (!g.anyLod && g.lod != filter.lod) continue;
+        const MeshRange& m = meshes_[g.mesh];
+        // The per-instance attribute reads 0, 1, 2, … starting at `first`, so the shader
+        // indexes the instance buffer with it (no gl_BaseInstance needed: GL 4.5 core).
+        glDrawElementsInstancedBaseVertexBaseInstance(
+            GL_TRIANGLES, static_cast<GLsizei>(m.indexCount), GL_UNSIGNED_INT,
+            reinterpret_cast<const void*>(static_cast<uintptr_t>(m.firstIndex) * 4), static_cast<GLsizei>(g.count),
+            static_cast<GLint>(m.baseVertex), g.first);
+    }
+    glBindVertexArray(0);
+}
+
+}  // namespace kiln::scene

@@ -1,0 +1,87 @@
+// scene/scene_renderer.hpp — the scene's geometry on the GPU, drawn by category for
+// the passes (drawScene).
+//
+// All meshes live in one vertex and one index buffer behind one VAO; instances live in
+// one shader storage buffer, grouped (mesh, category) so a filter is a handful of
+// instanced draws. Each geometry category carries a content version: it changes only
+// when that category's instances changed, so a pass that reads the shadow casters does
+// not re-run because a fireball moved.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "kiln/gl.hpp"
+#include "kiln/scene_view.hpp"
+#include "run/pass_context.hpp"
+
+namespace kiln::scene {
+
+// How the scene file says the scene looks (sim::Scene's box, lamp, tumbler shape).
+struct SceneLook {
+    glm::vec3 left{0.95f, 0.45f, 0.1f};    // orange
+    glm::vec3 right{0.35f, 0.65f, 0.95f};  // sky blue
+    glm::vec3 other{0.85f, 0.82f, 0.78f};  // back wall, ceiling (the floor is wood)
+    glm::vec3 woodLight{0.72f, 0.52f, 0.32f}, woodDark{0.45f, 0.28f, 0.15f};
+    float woodRingFrequency = 14.0f;
+    glm::vec3 lampCentre{0.0f, 1.1f, 0.0f};
+    float lampRadius = 0.35f;
+    glm::vec3 lampColor{1.0f, 0.95f, 0.85f};
+    float lampIntensity = 4.0f;
+    float tumblerB = 0.2f, tumblerT = 0.1f, tumblerAlpha = 0.349066f;
+};
+
+struct BodyInstance {
+    SceneCategory category = kSceneTumblers;  // tumblers, marbles, fireballs
+    glm::mat4 model{1.0f};                    // for spheres: translate × scale(radius)
+    glm::vec3 albedo{1.0f};
+    glm::vec3 emissive{0.0f};
+    bool highlighted = false;
+};
+
+struct ParticleInstance {
+    glm::vec3 position;
+    float radius;
+    glm::vec3 emissive;
+};
+
+class SceneRenderer final : public run::SceneDraw {
+public:
+    // (Re)builds every mesh (the lamp dome and the tumblers follow the look) and the
+    // walls' instances. Called on every scene (re)load.
+    void setLook(const SceneLook&);
+    void setBodies(const std::vector<BodyInstance>&);
+    void setParticles(const std::vector<ParticleInstance>&);
+    // Uploads what changed; call once per frame before the passes run.
+    void upload();
+    // Instanced draws of every group matching the filter with the current program.
+    void draw(const DrawFilter&) const override;
+    // Instances of one geometry category (kSceneBox ... kSceneParticles).
+    uint32_t count(SceneCategory single) const { return counts_[sceneCategoryIndex(single)]; }
+    // Changes whenever that geometry category's instance contents changed.
+    uint64_t version(SceneCategory single) const { return versions_[sceneCategoryIndex(single)]; }
+
+private:
+    enum MeshId { kQuad, kLamp, kTumblerHigh, kTumblerLow, kSphereHigh, kSphereLow, kMeshCount };
+    struct MeshRange { uint32_t firstIndex = 0, indexCount = 0, baseVertex = 0; };
+    struct Group { MeshId mesh; SceneCategory category; Lod lod; bool anyLod; uint32_t first, count; };
+
+    void buildMeshes(const SceneLook&);
+    void rebuildGroups();
+    void noteContents(SceneCategory, const GpuInstance* begin, size_t count);
+
+    std::array<MeshRange, kMeshCount> meshes_{};
+    gl::Buffer vertexBuffer_, indexBuffer_;
+    gl::VertexArrayHandle vao_;
+    gl::Buffer instanceBuffer_, instanceIds_;
+    size_t instanceCapacity_ = 0;
+    std::vector<GpuInstance> staticInstances_, bodyInstances_, particleInstances_;
+    std::vector<Group> groups_;
+    bool dirty_ = true;
+    uint32_t counts_[kSceneGeometryCount] = {};
+    uint64_t versions_[kSceneGeometryCount] = {};
+    uint64_t hashes_[kSceneGeometryCount] = {};
+};
+
+}  // namespace kiln::scene
