@@ -187,6 +187,62 @@ TEST_CASE("a scene edit resets the world; an invalid scene keeps it", "[live][gl
     CHECK(box.app.scene().sim().tumblers().size() == 1);
 }
 
+namespace {
+// The x of the emissive centroid of gbuffer.emissive (texels): where the lamp dome is.
+float emissiveCentroidX(app::App& app) {
+    const TextureRef* t = app.runtime().findTexture("gbuffer", "emissive");
+    FloatImage img = readTexture(t->id, t->target, t->format, t->width, t->height);
+    double sum = 0, weighted = 0;
+    for (int y = 0; y < img.height; ++y)
+        for (int x = 0; x < img.width; ++x) {
+            const float* p = img.at(x, y);
+            sum += p[0] + p[1] + p[2];
+            weighted += x * double(p[0] + p[1] + p[2]);
+        }
+    return sum > 0 ? float(weighted / sum) : -1.0f;
+}
+// The mean albedo of the G-buffer texels whose normal points up (the floor).
+glm::vec3 floorAlbedo(app::App& app) {
+    const TextureRef* a = app.runtime().findTexture("gbuffer", "albedo");
+    const TextureRef* n = app.runtime().findTexture("gbuffer", "normal");
+    FloatImage albedo = readTexture(a->id, a->target, a->format, a->width, a->height);
+    FloatImage normal = readTexture(n->id, n->target, n->format, n->width, n->height);
+    glm::vec3 sum(0.0f);
+    int count = 0;
+    for (int y = 0; y < albedo.height; ++y)
+        for (int x = 0; x < albedo.width; ++x)
+            if (normal.at(x, y)[1] > 0.99f) sum += glm::vec3(albedo.at(x, y)[0], albedo.at(x, y)[1], albedo.at(x, y)[2]), ++count;
+    return count ? sum / float(count) : glm::vec3(-1.0f);
+}
+std::string sceneWithLampAt(float x, const char* woodRgb) {
+    return std::string(R"({"tumblers": [{"position": [0.0, 0.3]}], "marbles": [], "fireballs": [],
+        "box": {"floor_wood": {"light": )") + woodRgb + R"(, "dark": )" + woodRgb + R"(, "ring_frequency": 14}},
+        "lamp": {"center": [)" + std::to_string(x) + R"(, 1.1, 0.0], "radius": 0.3}})";
+}
+}  // namespace
+
+TEST_CASE("a scene edit re-renders what the file says: the lamp dome moves, the floor takes its wood", "[live][gl]") {
+    Sandbox box("scene-look");
+    const fs::path scene = box.root / "scenes/cornell.json";
+    writeByRename(scene, sceneWithLampAt(-0.5f, "[0.0, 1.0, 0.0]"));
+    REQUIRE(box.waitFor([&] { return box.app.scene().sim().tumblers().size() == 1; }));
+    box.app.frame();
+    const float left = emissiveCentroidX(box.app);
+    // Light and dark wood both pure green: every floor texel is (0, 1, 0) exactly.
+    const glm::vec3 green = floorAlbedo(box.app);
+    INFO("floor albedo " << green.x << " " << green.y << " " << green.z);
+    CHECK(glm::length(green - glm::vec3(0.0f, 1.0f, 0.0f)) < 1e-3f);
+
+    writeByRename(scene, sceneWithLampAt(0.5f, "[1.0, 0.0, 0.0]"));
+    REQUIRE(box.waitFor([&] { return glm::length(floorAlbedo(box.app) - glm::vec3(1, 0, 0)) < 1e-3f; }));
+    const float right = emissiveCentroidX(box.app);
+    INFO("dome centroid x: " << left << " px, then " << right << " px (of 32)");
+    // The dome moved 1.0 m to the right: at 32 px across a 2 m box seen from the front,
+    // its centroid moves ≈ 10 px; 5 px is a margin a stale mesh (0 px) cannot reach.
+    CHECK(left > 0.0f);
+    CHECK(right - left > 5.0f);
+}
+
 TEST_CASE("ten saves in a burst cause one reload", "[live][gl]") {
     Sandbox box("burst");
     const fs::path frag = box.root / "shaders/composite/composite.frag";
