@@ -260,6 +260,93 @@ void drawToScreen(GLuint program, const TextureRef& t, const DisplaySettings& d,
     glUseProgram(0);
 }
 
+void installCallbacks(GLFWwindow* window) {
+    glfwSetScrollCallback(window, [](GLFWwindow* w, double, double dy) {
+        if (ImGui::GetIO().WantCaptureMouse) return;
+        auto* s = static_cast<WindowState*>(glfwGetWindowUserPointer(w));
+        s->app->camera().distance = std::clamp(s->app->camera().distance * float(std::pow(0.9, dy)), 1.5f, 10.0f);
+    });
+    glfwSetKeyCallback(window, [](GLFWwindow* w, int key, int, int action, int) {
+        if (action != GLFW_PRESS || ImGui::GetIO().WantCaptureKeyboard) return;
+        auto* s = static_cast<WindowState*>(glfwGetWindowUserPointer(w));
+        if (key == GLFW_KEY_ESCAPE) glfwSetWindowShouldClose(w, 1);
+        if (key == GLFW_KEY_F1) s->showDebug = !s->showDebug;
+        if (key == GLFW_KEY_SPACE) s->app->paused = !s->app->paused;
+        if (key == GLFW_KEY_PERIOD) s->app->singleStep = true;
+        if (key == GLFW_KEY_M) s->app->scene().sim().spawnRandom(sim::BallKind::Marble);
+        if (key == GLFW_KEY_F) s->app->scene().sim().spawnRandom(sim::BallKind::Fireball);
+        if (key == GLFW_KEY_R) s->app->scene().reset();
+    });
+}
+
+// Left button: on a tumbler it drags it (SPEC §4.4: below the centre of mass
+// translates, above rotates); on empty space it orbits the camera.
+void handleMouse(GLFWwindow* window, WindowState& state) {
+    App& app = *state.app;
+    double x, y;
+    glfwGetCursorPos(window, &x, &y);
+    int winW, winH;
+    glfwGetWindowSize(window, &winW, &winH);
+    const bool down = glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS;
+    auto& sim = app.scene().sim();
+    if (down && !ImGui::GetIO().WantCaptureMouse) {
+        glm::vec3 origin, dir;
+        app.camera().rayThrough(x, y, winW, winH, origin, dir);
+        if (!state.dragging) {
+            state.dragging = true;
+            state.draggingTumbler = false;
+            if (auto hit = sim.raycastTumblers(sim::Vec3(origin), sim::Vec3(dir))) {
+                state.dragMode = sim.beginDrag(*hit);
+                state.draggingTumbler = true;
+            }
+        } else if (state.draggingTumbler) {
+            if (state.dragMode == sim::DragMode::Translate)
+                sim.dragTo(sim::Vec3(origin), sim::Vec3(dir));
+            else  // screen drag right tilts about −z (rolls right), drag down tilts about +x
+                sim.dragRotate((y - state.lastY) * 0.01, -(x - state.lastX) * 0.01);
+        } else {
+            app.camera().yaw -= float(x - state.lastX) * 0.005f;
+            app.camera().pitch = std::clamp(app.camera().pitch + float(y - state.lastY) * 0.005f, -1.2f, 1.2f);
+        }
+    } else if (state.dragging) {
+        if (state.draggingTumbler) sim.endDrag();
+        state.dragging = state.draggingTumbler = false;
+    }
+    state.lastX = x, state.lastY = y;
+}
+
+void drawDebugView(WindowState& state) {
+    App& app = *state.app;
+    ImGui_ImplOpenGL3_NewFrame();
+    ImGui_ImplGlfw_NewFrame();
+    ImGui::NewFrame();
+    if (state.showDebug) {
+        ImGui::SetNextWindowPos(ImVec2(8, 8), ImGuiCond_FirstUseEver);
+        ImGui::SetNextWindowSize(ImVec2(420, 520), ImGuiCond_FirstUseEver);
+        ImGui::Begin("Kiln (F1)");
+        ImGui::Text("%s", app.runtime().pipelineFile().c_str());
+        panelPasses(app, state.editor);
+        panelTextures(app, state.display);
+        panelScene(app);
+        ImGui::End();
+    }
+    panelErrors(app);
+    ImGui::Render();
+    ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+}
+
+// The whole window, debug view included (README screenshots under xvfb-run).
+void saveScreenshot(const std::string& path, int width, int height) {
+    FloatImage img;
+    img.width = width, img.height = height;
+    img.pixels.resize(size_t(width) * height * 4);
+    glReadBuffer(GL_BACK);
+    glReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, img.pixels.data());
+    std::string error;
+    if (!writePng(path, img, 3, error)) log::error(error);
+    else log::info("wrote ", path);
+}
+
 }  // namespace
 
 int runWindow(const Options& o) {
@@ -279,23 +366,7 @@ int runWindow(const Options& o) {
     state.app = &app;
     GLFWwindow* window = context->window();
     glfwSetWindowUserPointer(window, &state);
-
-    glfwSetScrollCallback(window, [](GLFWwindow* w, double, double dy) {
-        if (ImGui::GetIO().WantCaptureMouse) return;
-        auto* s = static_cast<WindowState*>(glfwGetWindowUserPointer(w));
-        s->app->camera().distance = std::clamp(s->app->camera().distance * float(std::pow(0.9, dy)), 1.5f, 10.0f);
-    });
-    glfwSetKeyCallback(window, [](GLFWwindow* w, int key, int, int action, int) {
-        if (action != GLFW_PRESS || ImGui::GetIO().WantCaptureKeyboard) return;
-        auto* s = static_cast<WindowState*>(glfwGetWindowUserPointer(w));
-        if (key == GLFW_KEY_ESCAPE) glfwSetWindowShouldClose(w, 1);
-        if (key == GLFW_KEY_F1) s->showDebug = !s->showDebug;
-        if (key == GLFW_KEY_SPACE) s->app->paused = !s->app->paused;
-        if (key == GLFW_KEY_PERIOD) s->app->singleStep = true;
-        if (key == GLFW_KEY_M) s->app->scene().sim().spawnRandom(sim::BallKind::Marble);
-        if (key == GLFW_KEY_F) s->app->scene().sim().spawnRandom(sim::BallKind::Fireball);
-        if (key == GLFW_KEY_R) s->app->scene().reset();
-    });
+    installCallbacks(window);
     // Ours first: ImGui's GLFW backend chains to the callbacks it finds installed.
     IMGUI_CHECKVERSION();
     ImGui::CreateContext();
@@ -306,76 +377,17 @@ int runWindow(const Options& o) {
     GLuint displayProgram = buildDisplayProgram(app.runtime().shaders());
     GLuint vao = 0;
     glCreateVertexArrays(1, &vao);
-
-    int frames = 0;
-    while (!glfwWindowShouldClose(window)) {
+    for (int frames = 1; !glfwWindowShouldClose(window); ++frames) {
         glfwPollEvents();
-        // Left button: on a tumbler it drags it (SPEC §4.4: below the centre of mass
-        // translates, above rotates); on empty space it orbits the camera.
-        double x, y;
-        glfwGetCursorPos(window, &x, &y);
-        int winW, winH;
-        glfwGetWindowSize(window, &winW, &winH);
-        const bool down = glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS;
-        auto& sim = app.scene().sim();
-        if (down && !ImGui::GetIO().WantCaptureMouse) {
-            glm::vec3 origin, dir;
-            app.camera().rayThrough(x, y, winW, winH, origin, dir);
-            if (!state.dragging) {
-                state.dragging = true;
-                state.draggingTumbler = false;
-                if (auto hit = sim.raycastTumblers(sim::Vec3(origin), sim::Vec3(dir))) {
-                    state.dragMode = sim.beginDrag(*hit);
-                    state.draggingTumbler = true;
-                }
-            } else if (state.draggingTumbler) {
-                if (state.dragMode == sim::DragMode::Translate)
-                    sim.dragTo(sim::Vec3(origin), sim::Vec3(dir));
-                else  // screen drag right tilts about −z (rolls right), drag down tilts about +x
-                    sim.dragRotate((y - state.lastY) * 0.01, -(x - state.lastX) * 0.01);
-            } else {
-                app.camera().yaw -= float(x - state.lastX) * 0.005f;
-                app.camera().pitch = std::clamp(app.camera().pitch + float(y - state.lastY) * 0.005f, -1.2f, 1.2f);
-            }
-        } else if (state.dragging) {
-            if (state.draggingTumbler) sim.endDrag();
-            state.dragging = state.draggingTumbler = false;
-        }
-        state.lastX = x, state.lastY = y;
-
+        handleMouse(window, state);
         int fbW, fbH;
         glfwGetFramebufferSize(window, &fbW, &fbH);
         app.resize(fbW, fbH);
         app.frame();
         if (const TextureRef* t = app.displayedTexture()) drawToScreen(displayProgram, *t, state.display, fbW, fbH, vao);
-
-        ImGui_ImplOpenGL3_NewFrame();
-        ImGui_ImplGlfw_NewFrame();
-        ImGui::NewFrame();
-        if (state.showDebug) {
-            ImGui::SetNextWindowPos(ImVec2(8, 8), ImGuiCond_FirstUseEver);
-            ImGui::SetNextWindowSize(ImVec2(420, 520), ImGuiCond_FirstUseEver);
-            ImGui::Begin("Kiln (F1)");
-            ImGui::Text("%s", app.runtime().pipelineFile().c_str());
-            panelPasses(app, state.editor);
-            panelTextures(app, state.display);
-            panelScene(app);
-            ImGui::End();
-        }
-        panelErrors(app);
-        ImGui::Render();
-        ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
-        ++frames;
+        drawDebugView(state);
         if (!o.screenshot.empty() && frames == o.frames) {
-            // The whole window, debug view included (README screenshots under xvfb-run).
-            FloatImage img;
-            img.width = fbW, img.height = fbH;
-            img.pixels.resize(size_t(fbW) * fbH * 4);
-            glReadBuffer(GL_BACK);
-            glReadPixels(0, 0, fbW, fbH, GL_RGBA, GL_FLOAT, img.pixels.data());
-            std::string error;
-            if (!writePng(o.screenshot, img, 3, error)) log::error(error);
-            else log::info("wrote ", o.screenshot);
+            saveScreenshot(o.screenshot, fbW, fbH);
             glfwSetWindowShouldClose(window, 1);
         }
         glfwSwapBuffers(window);

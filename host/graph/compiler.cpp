@@ -58,6 +58,40 @@ bool splitBinding(const std::string& text, std::string& pass, std::string& outpu
     return true;
 }
 
+// Problems in one output or internal texture declaration.
+void checkTexture(const char* what, const TextureDecl& t, const PassDeclaration& d, std::vector<std::string>& problems) {
+    const std::string name = std::string(what) + " " + q(t.name);
+    if ((t.kind == TextureKind::Depth2D) != isDepthFormat(t.format))
+        problems.push_back(name + " is " + toString(t.kind) + " but has format " + toString(t.format));
+    switch (t.size.mode) {
+        case SizeRule::Mode::RelativeToOutput:
+            if (t.kind == TextureKind::Color3D)
+                problems.push_back(name + " is 3D but sized relative to the (2D) output");
+            if (!(t.size.scale > 0.0f)) problems.push_back(name + " has scale " + num(t.size.scale) + " (must be > 0)");
+            break;
+        case SizeRule::Mode::Fixed:
+            if (t.size.width < 1 || t.size.height < 1 || (t.kind == TextureKind::Color3D && t.size.depth < 1))
+                problems.push_back(name + " has a fixed size with a side < 1");
+            break;
+        case SizeRule::Mode::FromParam: {
+            auto it = std::find_if(d.params.begin(), d.params.end(),
+                                   [&](const ParamDecl& p) { return p.name == t.size.source; });
+            if (it == d.params.end())
+                problems.push_back(name + " takes its size from unknown parameter " + q(t.size.source));
+            else if (it->type != ParamType::Int)
+                problems.push_back(name + " takes its size from parameter " + q(t.size.source) + ", which is a " +
+                                   toString(it->type) + ", not an int");
+            break;
+        }
+        case SizeRule::Mode::FromInput:
+            if (std::none_of(d.inputs.begin(), d.inputs.end(), [&](const InputDecl& in) { return in.name == t.size.source; }))
+                problems.push_back(name + " takes its size from unknown input " + q(t.size.source));
+            if (!(t.size.scale > 0.0f)) problems.push_back(name + " has scale " + num(t.size.scale) + " (must be > 0)");
+            break;
+    }
+    if (t.mips < 0) problems.push_back(name + " has a negative mip count");
+}
+
 // Problems in a module's own declaration: they are bugs in the module, reported
 // against the pass that uses it so the user knows which module to fix.
 std::vector<std::string> checkDeclaration(const PassDeclaration& d) {
@@ -97,40 +131,8 @@ std::vector<std::string> checkDeclaration(const PassDeclaration& d) {
                                ", which is not one of its allowed values");
     }
 
-    auto checkTexture = [&](const char* what, const TextureDecl& t) {
-        const std::string name = std::string(what) + " " + q(t.name);
-        if ((t.kind == TextureKind::Depth2D) != isDepthFormat(t.format))
-            problems.push_back(name + " is " + toString(t.kind) + " but has format " + toString(t.format));
-        switch (t.size.mode) {
-            case SizeRule::Mode::RelativeToOutput:
-                if (t.kind == TextureKind::Color3D)
-                    problems.push_back(name + " is 3D but sized relative to the (2D) output");
-                if (!(t.size.scale > 0.0f)) problems.push_back(name + " has scale " + num(t.size.scale) + " (must be > 0)");
-                break;
-            case SizeRule::Mode::Fixed:
-                if (t.size.width < 1 || t.size.height < 1 || (t.kind == TextureKind::Color3D && t.size.depth < 1))
-                    problems.push_back(name + " has a fixed size with a side < 1");
-                break;
-            case SizeRule::Mode::FromParam: {
-                auto it = std::find_if(d.params.begin(), d.params.end(),
-                                       [&](const ParamDecl& p) { return p.name == t.size.source; });
-                if (it == d.params.end())
-                    problems.push_back(name + " takes its size from unknown parameter " + q(t.size.source));
-                else if (it->type != ParamType::Int)
-                    problems.push_back(name + " takes its size from parameter " + q(t.size.source) + ", which is a " +
-                                       toString(it->type) + ", not an int");
-                break;
-            }
-            case SizeRule::Mode::FromInput:
-                if (std::none_of(d.inputs.begin(), d.inputs.end(), [&](const InputDecl& in) { return in.name == t.size.source; }))
-                    problems.push_back(name + " takes its size from unknown input " + q(t.size.source));
-                if (!(t.size.scale > 0.0f)) problems.push_back(name + " has scale " + num(t.size.scale) + " (must be > 0)");
-                break;
-        }
-        if (t.mips < 0) problems.push_back(name + " has a negative mip count");
-    };
-    for (const TextureDecl& t : d.outputs) checkTexture("output", t);
-    for (const TextureDecl& t : d.internals) checkTexture("internal texture", t);
+    for (const TextureDecl& t : d.outputs) checkTexture("output", t, d, problems);
+    for (const TextureDecl& t : d.internals) checkTexture("internal texture", t, d, problems);
     return problems;
 }
 
@@ -433,67 +435,8 @@ private:
         }
         std::set<std::string> mentioned;  // slots the file binds (validly or not)
         for (const auto& [slot, text] : p.inputs) {
-            const std::string path = passPath(i) + ".inputs." + slot;
             mentioned.insert(slot);
-            const InputDecl* in = nullptr;
-            if (decl) {
-                auto it = std::find_if(decl->inputs.begin(), decl->inputs.end(),
-                                       [&](const InputDecl& d) { return d.name == slot; });
-                if (it == decl->inputs.end()) {
-                    passError(i, path, "module " + q(p.module) + " has no input " + q(slot) +
-                                           suggestion(slot, slots, "inputs"));
-                    continue;
-                }
-                in = &*it;
-            }
-            std::string producerId, outputName;
-            if (!splitBinding(text, producerId, outputName)) {
-                std::string hint;
-                auto id = ids_.find(text);
-                if (id != ids_.end() && decls_[static_cast<size_t>(id->second)] &&
-                    !decls_[static_cast<size_t>(id->second)]->outputs.empty())
-                    hint = " (e.g. " + q(text + "." + decls_[static_cast<size_t>(id->second)]->outputs[0].name) + ")";
-                passError(i, path, "malformed binding " + q(text) + ": expected \"<pass id>.<output>\"" + hint);
-                continue;
-            }
-            const int j = lookupPass(producerId, i, path);
-            if (j < 0) continue;
-            if (j == i) {
-                passError(i, path, "input bound to its own pass (" + q(text) + "): a pass cannot read what it writes");
-                continue;
-            }
-            if (j > i) {
-                passError(i, path, q(text) + " is produced later in the file: move " + q(producerId) + " (" +
-                                       passPath(j) + ") before " + q(p.id) + " (" + passPath(i) + ")");
-                continue;
-            }
-            const PassDeclaration* producer = decls_[static_cast<size_t>(j)];
-            if (!producer || !in) continue;  // already reported against that pass's module
-            auto out = std::find_if(producer->outputs.begin(), producer->outputs.end(),
-                                    [&](const TextureDecl& t) { return t.name == outputName; });
-            if (out == producer->outputs.end()) {
-                passError(i, path, missingOutput(j, outputName));
-                continue;
-            }
-            if (out->kind != in->kind) {
-                passError(i, path, "input " + q(slot) + " expects a " + toString(in->kind) + " texture, but " + q(text) +
-                                       " is " + describe(*out));
-                continue;
-            }
-            Binding& b = *std::find_if(pp.bindings.begin(), pp.bindings.end(),
-                                       [&](const Binding& x) { return x.slot == slot; });
-            if (!enabled(j)) {
-                if (in->required) {
-                    passError(i, path, q(p.id) + " loses required input " + q(slot) + ": its producer " +
-                                           q(producerId) + " (" + passPath(j) + ", which writes " + text +
-                                           ") is disabled");
-                    continue;
-                }
-                b.lost = text;  // optional: read the fallback instead
-                continue;
-            }
-            b.producer = j;
-            b.output = outputName;
+            bindInput(i, slot, text, slots);
         }
         if (!decl) return;
         for (const InputDecl& in : decl->inputs) {
@@ -502,6 +445,74 @@ private:
                       "required input " + q(in.name) + " (" + toString(in.kind) + ") is not bound" +
                           candidates(i, in.kind));
         }
+    }
+
+    // One `"slot": "pass.output"` of pass i's inputs: checked, then bound (or marked lost
+    // when its producer is disabled and the input is optional).
+    void bindInput(int i, const std::string& slot, const std::string& text, const std::vector<std::string>& slots) {
+        const PassDesc& p = desc_.passes[static_cast<size_t>(i)];
+        const PassDeclaration* decl = decls_[static_cast<size_t>(i)];
+        PlannedPass& pp = plan_.passes[static_cast<size_t>(i)];
+        const std::string path = passPath(i) + ".inputs." + slot;
+        const InputDecl* in = nullptr;
+        if (decl) {
+            auto it = std::find_if(decl->inputs.begin(), decl->inputs.end(),
+                                   [&](const InputDecl& d) { return d.name == slot; });
+            if (it == decl->inputs.end()) {
+                passError(i, path, "module " + q(p.module) + " has no input " + q(slot) +
+                                       suggestion(slot, slots, "inputs"));
+                return;
+            }
+            in = &*it;
+        }
+        std::string producerId, outputName;
+        if (!splitBinding(text, producerId, outputName)) {
+            std::string hint;
+            auto id = ids_.find(text);
+            if (id != ids_.end() && decls_[static_cast<size_t>(id->second)] &&
+                !decls_[static_cast<size_t>(id->second)]->outputs.empty())
+                hint = " (e.g. " + q(text + "." + decls_[static_cast<size_t>(id->second)]->outputs[0].name) + ")";
+            passError(i, path, "malformed binding " + q(text) + ": expected \"<pass id>.<output>\"" + hint);
+            return;
+        }
+        const int j = lookupPass(producerId, i, path);
+        if (j < 0) return;
+        if (j == i) {
+            passError(i, path, "input bound to its own pass (" + q(text) + "): a pass cannot read what it writes");
+            return;
+        }
+        if (j > i) {
+            passError(i, path, q(text) + " is produced later in the file: move " + q(producerId) + " (" +
+                                   passPath(j) + ") before " + q(p.id) + " (" + passPath(i) + ")");
+            return;
+        }
+        const PassDeclaration* producer = decls_[static_cast<size_t>(j)];
+        if (!producer || !in) return;  // already reported against that pass's module
+        auto out = std::find_if(producer->outputs.begin(), producer->outputs.end(),
+                                [&](const TextureDecl& t) { return t.name == outputName; });
+        if (out == producer->outputs.end()) {
+            passError(i, path, missingOutput(j, outputName));
+            return;
+        }
+        if (out->kind != in->kind) {
+            passError(i, path, "input " + q(slot) + " expects a " + toString(in->kind) + " texture, but " + q(text) +
+                                   " is " + describe(*out));
+            return;
+        }
+        Binding& b = *std::find_if(pp.bindings.begin(), pp.bindings.end(),
+                                   [&](const Binding& x) { return x.slot == slot; });
+        if (!enabled(j)) {
+            if (in->required) {
+                passError(i, path, q(p.id) + " loses required input " + q(slot) + ": its producer " +
+                                       q(producerId) + " (" + passPath(j) + ", which writes " + text +
+                                       ") is disabled");
+                return;
+            }
+            b.lost = text;  // optional: read the fallback instead
+            return;
+        }
+        b.producer = j;
+        b.output = outputName;
     }
 
     // ' (e.g. "gbuffer.depth")': earlier enabled outputs of the right kind.

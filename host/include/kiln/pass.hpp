@@ -1,4 +1,5 @@
-// kiln/pass.hpp — the pass ABI. This comment is the pass author's manual.
+// kiln/pass.hpp — the pass ABI. This comment is the pass author's manual: this header
+// and your folder passes/<name>/ are all a pass author needs to open.
 //
 // WHAT A PASS IS
 //   A shared library (a "module") in build/modules/libpass_<name>.so that exports one
@@ -8,7 +9,8 @@
 //   A pass owns code and shaders only: the host owns its textures, its parameter
 //   values and everything that must survive a reload of the module.
 //
-// WRITING ONE (passes/<name>/, two files)
+// WRITING ONE (passes/<name>/, two files, then re-run CMake once: `cmake build` — the
+// pass folders are found when CMake configures)
 //   passes/<name>/CMakeLists.txt:   kiln_add_pass(<name> <name>.cpp)
 //   passes/<name>/<name>.cpp:
 //
@@ -18,16 +20,14 @@
 //         kiln::PassDeclaration d;
 //         d.input({.name = "color", .kind = kiln::TextureKind::Color2D})
 //          .output({.name = "color", .format = kiln::Format::RGBA16F})
-//          .param(kiln::colorParam("tint", {1, 0.5f, 0.5f}, "multiplies the colour"))
-//          .shader("tint/tint.frag");
+//          .param(kiln::colorParam("tint", {1, 0.5f, 0.5f}, "multiplies the colour"));
 //         return d;
 //       }
 //       void execute(kiln::PassContext& ctx) override {
 //         GLuint prog = ctx.program({.stages = {"common/fullscreen.vert", "tint/tint.frag"}});
-//         if (!prog) return;                        // compile error: the host shows it
-//         glBindFramebuffer(GL_FRAMEBUFFER, ctx.framebuffer({"color"}));
+//         if (!prog || !ctx.framebuffer({"color"})) return;  // the host shows the error
 //         glUseProgram(prog);
-//         glBindTextureUnit(0, ctx.input("color").id);
+//         glBindTextureUnit(0, ctx.input("color").id);      // layout(binding = 0) in the shader
 //         auto t = ctx.getColor("tint");
 //         glUniform3f(glGetUniformLocation(prog, "u_tint"), t[0], t[1], t[2]);
 //         ctx.drawFullscreenTriangle();
@@ -35,45 +35,80 @@
 //     };
 //     KILN_PASS_MODULE(tint, Tint)
 //
+//   shaders/tint/tint.frag:
+//     #version 450 core
+//     layout(binding = 0) uniform sampler2D u_color;
+//     uniform vec3 u_tint;
+//     in vec2 v_uv;                                         // from common/fullscreen.vert
+//     layout(location = 0) out vec4 o_color;
+//     void main() { o_color = vec4(texture(u_color, v_uv).rgb * u_tint, 1.0); }
+//
 // DECLARING (see kiln/declare.hpp for every field)
 //   inputs     named slots a pipeline binds to "<pass id>.<output>"; kind Color2D,
 //              Depth2D or Color3D; required, or optional with a fallback texture
 //              (black / white / flat normal / far depth). An unbound optional input
 //              reaches your shaders as `#define KILN_HAS_<SLOT> 0` (1 when bound).
-//   outputs    format, 2D/3D, size rule (relative to the output size, fixed, or a
-//              side taken from an int parameter), mip count.
+//   outputs    format, 2D/3D, size rule, mip count. Size rules: relative to the output
+//              size, fixed, a side taken from an int parameter (fromParam), or the size
+//              of what is bound to one of your inputs (fromInput).
 //   internals  scratch textures (ping-pong, mip levels): allocated by the host, not
 //              bindable by other passes, listed in the debug view like outputs.
 //   params     name, type, default, range or choices: they drive the JSON validation
 //              and the debug UI. Read them in execute() with ctx.getFloat("name") etc.
-//   shaders    the files you use, relative to the shader roots (shaders/).
-//   reads      the scene categories you read (kSceneBodies, kSceneCamera, ...).
+//   reads      the scene categories you read (SceneCategory in kiln/declare.hpp:
+//              kSceneShadowCasters, kSceneBodies, kSceneLight, kSceneCamera, ...). The
+//              geometry bits are also what ctx.drawScene() filters on.
 //
 // SKIPPING
-//   The host re-runs a pass only when an input's version, a parameter, or a scene
-//   category it `reads` changed since its last run, or it is `timeDependent`.
-//   Otherwise its outputs keep their contents and the skip ripples down the graph.
-//   Inside execute(), ctx.nothingToDo("why") says the scene holds nothing for you
-//   (your outputs keep their contents and versions).
+//   The host re-runs a pass only when an input's version, a parameter, a scene
+//   category it `reads` or the output size changed since its last run, or one of its
+//   programs was rebuilt, or it is `timeDependent`. Otherwise its outputs keep their
+//   contents and the skip ripples down the graph. Inside execute(),
+//   ctx.nothingToDo("why") says the scene holds nothing for you: your outputs keep
+//   their contents and versions, and the debug view shows the reason.
 //
 // EXECUTING
-//   ctx.input/output/internal("name") give TextureRef (GL name + shape). ctx.program()
-//   compiles (once, cached; recompiled on shader edits) and returns 0 if the shaders
-//   have an error, which the host reports as `shaders/x/y.frag:LINE: message`.
-//   ctx.framebuffer({"a","b"}, "depth") returns a cached FBO over your outputs.
+//   ctx.input/output/internal("name") give a TextureRef (GL name + shape); asking for
+//   a name you did not declare fails the pass with a message naming it.
+//   ctx.program() compiles (once, cached; rebuilt on shader edits; at most 16 variants
+//   per pass) and returns 0 if the shaders have an error, which the host reports as
+//   `shaders/x/y.frag:LINE: message` and keeps showing until the file is fixed.
+//   ctx.framebuffer({"a","b"}, "depth", mip) binds a cached FBO over your outputs or
+//   internals and sets the viewport to the first attachment; it returns 0 (and fails
+//   the pass) when the FBO is incomplete.
+//   ctx.fail("why") stops this run: the pass shows "error" with your message, its
+//   outputs keep their versions, and it runs again next frame.
 //   ctx.drawScene(filter) draws the scene's meshes instanced; your vertex shader
 //   includes "common/scene.glsl" for the attributes and the instance buffer.
-//   ctx.drawFullscreenTriangle() for screen passes (vertex shader
-//   "common/fullscreen.vert"). The frame uniforms (camera, light, output size, time)
-//   are bound as "common/frame.glsl" expects. The host wraps each pass in a KHR_debug
-//   group and times it (GPU timer query + CPU clock).
+//   ctx.drawFullscreenTriangle() for screen passes: vertex shader
+//   "common/fullscreen.vert", which hands the fragment shader `in vec2 v_uv` (0..1).
+//   The frame uniforms (camera, lamp, output size, time, the floor's wood) are bound as
+//   "common/frame.glsl" expects. The host wraps each pass in a KHR_debug group and
+//   times it (GPU timestamps + CPU clock).
+//
+// TEXTURE UNITS AND BINDINGS
+//   Shaders declare `layout(binding = N)` for every sampler, image and buffer block;
+//   execute() binds to the same N (glBindTextureUnit(N, ...), glBindImageTexture(N,
+//   ...)). Reserved by the host: uniform block binding 0 (common/frame.glsl) and
+//   shader storage binding 0 (the instances of common/instances.glsl) while drawScene
+//   runs.
+//
+// GL STATE
+//   Before each pass the host resets: framebuffer 0 and the viewport to the output
+//   size; depth test off, depth func LESS, depth writes on; blending off, blend func
+//   (ONE, ZERO); face culling off, cull face BACK; polygon offset fill off, offset 0;
+//   scissor and stencil tests off; colour writes on; program 0; vertex array 0;
+//   texture units 0–15 and image units 0–7 unbound; the frame uniform block bound.
+//   Anything else you change (clip control, point size, SSBO bindings other than 0,
+//   memory barriers) is yours to restore or to set every time.
 //
 // RULES THAT KEEP RELOADING SAFE (see "Live editing" in the README)
 //   Set every uniform in each execute(): a shader edit swaps in a new program and no
 //   uniform value is carried over (so nothing needs restoring by reflection).
-//   No state in statics (a reload loses it); no thread_local with destructors; leave
-//   GL bindings as you like, the host resets the ones it relies on. Modules are built
-//   with -fvisibility=hidden -fno-gnu-unique by kiln_add_pass.
+//   No state in statics (a reload loses it); no thread_local with destructors. State
+//   in members is a cache only: a module reload or a parameter change gives you a new
+//   object. Modules are built with -fvisibility=hidden -fno-gnu-unique by
+//   kiln_add_pass (cmake/KilnModule.cmake).
 #pragma once
 
 #include <cstdint>
