@@ -55,6 +55,14 @@ inline std::map<std::string, PassDeclaration> fakeModules() {
         .param(colorParam("tint", {1.0f, 1.0f, 1.0f}))
         .param(boolParam("pcf", true));
 
+    // Outputs sized like an input: a half-size copy of a 3D volume (voxel_mip's shape).
+    m["halve"]
+        .input({"volume", TextureKind::Color3D, true, Fallback::Black, ""})
+        .output({"half", TextureKind::Color3D, Format::RGBA16F, SizeRule::fromInput("volume", 0.5f), 1, ""});
+    m["input_sized_wrong"]
+        .input({"volume", TextureKind::Color3D, true, Fallback::Black, ""})
+        .output({"copy", TextureKind::Color3D, Format::RGBA16F, SizeRule::fromInput("volum"), 1, ""});
+
     // A module whose declaration is wrong: its output size names a missing parameter.
     m["broken_decl"]
         .output({"color", TextureKind::Color2D, Format::RGBA8, SizeRule::fromParam("sise"), 1, ""})

@@ -172,6 +172,44 @@ TEST_CASE("resolveSize", "[plan][size]") {
     CHECK(describeSize(t, params) == "32x16x8");
 }
 
+TEST_CASE("fromInput sizes follow the producer through the bindings", "[plan][size]") {
+    // voxelize's radiance is a resolution³ cube; halve's output is half of whatever is
+    // bound to its input, and a second halve halves that again.
+    auto plan = compileText(R"({"output": "composite.color", "passes": [
+        {"id": "gbuffer", "module": "gbuffer"},
+        {"id": "shadow", "module": "shadow"},
+        {"id": "voxelize", "module": "voxelize", "inputs": {"shadow_map": "shadow.depth"},
+         "params": {"resolution": 128}},
+        {"id": "h1", "module": "halve", "inputs": {"volume": "voxelize.radiance"}},
+        {"id": "h2", "module": "halve", "inputs": {"volume": "h1.half"}},
+        {"id": "composite", "module": "composite",
+         "inputs": {"albedo": "gbuffer.albedo", "normal": "gbuffer.normal", "depth": "gbuffer.depth"}}]})",
+                            "x.json", fakeOptions({"h2.half"}));
+    INFO(plan.errorText());
+    REQUIRE(plan.ok());
+    CHECK(plan->extentOf(plan->find("voxelize"), "radiance", 640, 480) == Extent{128, 128, 128});
+    CHECK(plan->extentOf(plan->find("h1"), "half", 640, 480) == Extent{64, 64, 64});
+    CHECK(plan->extentOf(plan->find("h2"), "half", 640, 480) == Extent{32, 32, 32});
+    CHECK(plan->extentOf(plan->find("gbuffer"), "albedo", 640, 480) == Extent{640, 480, 1});
+    CHECK(describeSize(*plan->passes[size_t(plan->find("h1"))].output("half"), {}) == "0.50× as input volume");
+    // Unknown pass or texture: the 1×1×1 of "nothing".
+    CHECK(plan->extentOf(99, "half", 640, 480) == Extent{});
+    CHECK(plan->extentOf(plan->find("h1"), "nope", 640, 480) == Extent{});
+}
+
+TEST_CASE("a fromInput size that names no input is the module's bug, reported against the pass", "[plan][size]") {
+    auto plan = compileText(R"({"output": "composite.color", "passes": [
+        {"id": "gbuffer", "module": "gbuffer"},
+        {"id": "shadow", "module": "shadow"},
+        {"id": "voxelize", "module": "voxelize", "inputs": {"shadow_map": "shadow.depth"}},
+        {"id": "copy", "module": "input_sized_wrong", "inputs": {"volume": "voxelize.radiance"}},
+        {"id": "composite", "module": "composite",
+         "inputs": {"albedo": "gbuffer.albedo", "normal": "gbuffer.normal", "depth": "gbuffer.depth"}}]})",
+                            "x.json", fakeOptions());
+    REQUIRE_FALSE(plan.ok());
+    CHECK_THAT(plan.errorText(), Catch::Contains("output \"copy\" takes its size from unknown input \"volum\""));
+}
+
 TEST_CASE("the table lists every pass with its state", "[plan][print]") {
     const std::string json = replaced(kBasicPipeline, R"("id": "shadow", "module": "shadow",)",
                                       R"("id": "shadow", "module": "shadow", "enabled": false,)");

@@ -2,6 +2,7 @@
 // and the golden image of the default pipeline.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 
@@ -124,4 +125,45 @@ TEST_CASE("golden image: default pipeline at 160x160, seed 1, time frozen", "[sc
     // range absorbs rasterisation differences between Mesa versions and GPUs while a
     // missing wall, shadow or tumbler (RMSE > 0.05) still fails.
     CHECK(rmse < 0.01);
+}
+
+namespace {
+float maxLuminance(app::App& app, const char* pass, const char* name) {
+    const TextureRef* t = app.runtime().findTexture(pass, name);
+    REQUIRE(t);
+    FloatImage img = readTexture(t->id, t->target, t->format, t->width, t->height);
+    float m = 0.0f;
+    for (int y = 0; y < img.height; ++y)
+        for (int x = 0; x < img.width; ++x) {
+            const float* p = img.at(x, y);
+            m = std::max(m, 0.2126f * p[0] + 0.7152f * p[1] + 0.0722f * p[2]);
+        }
+    return m;
+}
+std::string bloomPipeline(float threshold) {
+    return R"({"output": "bloom.bloom", "passes": [
+        {"id": "gbuffer", "module": "gbuffer"},
+        {"id": "bloom", "module": "bloom", "inputs": {"color": "gbuffer.emissive"},
+         "params": {"threshold": )" + std::to_string(threshold) + "}}]}";
+}
+}  // namespace
+
+TEST_CASE("bloom glows below the brightest emitter's luminance and is exactly black above it", "[scene][gl]") {
+    Rig rig({}, 64);
+    std::string errors;
+    REQUIRE(rig.app.runtime().loadPipelineText(bloomPipeline(1.0f), "bloom.json", errors));
+    rig.app.frame();
+    const float brightest = maxLuminance(rig.app, "gbuffer", "emissive");  // the lamp, the fireballs
+    REQUIRE(brightest > 1.0f);
+    REQUIRE(brightest < 60.0f);  // inside the threshold's range
+    // Just below the brightest texel: something passes and is blurred.
+    REQUIRE(rig.app.runtime().loadPipelineText(bloomPipeline(0.9f * brightest), "bloom.json", errors));
+    rig.app.frame();
+    CHECK(maxLuminance(rig.app, "bloom", "bloom") > 1e-3f);
+    CHECK(rig.stateOf("bloom") == "ran");
+    // Just above it: nothing may glow, not even rounding noise (the GPU-side early out
+    // writes exact zeros).
+    REQUIRE(rig.app.runtime().loadPipelineText(bloomPipeline(1.01f * brightest), "bloom.json", errors));
+    rig.app.frame();
+    CHECK(maxLuminance(rig.app, "bloom", "bloom") == 0.0f);
 }
