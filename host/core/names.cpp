@@ -34,12 +34,25 @@ int editDistance(std::string_view a, std::string_view b) {
     return prev[m];
 }
 
+namespace {
+// Names in messages are user text: shown at most this long.
+constexpr size_t kShownNameLength = 48;
+// Longer than this, a name is no typo of anything (and the O(n·m) distance is skipped).
+constexpr size_t kSuggestableLength = 256;
+
+std::string shown(std::string_view s) {
+    return s.size() <= kShownNameLength ? std::string(s) : std::string(s.substr(0, kShownNameLength)) + "…";
+}
+}  // namespace
+
 std::string nearestName(std::string_view name, const std::vector<std::string>& candidates) {
+    if (name.size() > kSuggestableLength) return {};
     const int limit = std::max<int>(1, static_cast<int>(name.size()) / 3);
     int best = limit + 1;
     const std::string* found = nullptr;
     for (const std::string& c : candidates) {
-        if (c == name) continue;
+        // The distance is at least the difference in length.
+        if (c == name || c.size() > name.size() + size_t(limit) || name.size() > c.size() + size_t(limit)) continue;
         const int d = editDistance(name, c);
         if (d < best) {
             best = d;
@@ -51,14 +64,14 @@ std::string nearestName(std::string_view name, const std::vector<std::string>& c
 
 std::string suggestion(std::string_view name, const std::vector<std::string>& candidates, std::string_view what) {
     std::string near = nearestName(name, candidates);
-    if (!near.empty()) return " (did you mean \"" + near + "\"?)";
+    if (!near.empty()) return " (did you mean \"" + shown(near) + "\"?)";
     if (candidates.empty() || candidates.size() > 10) return {};
     std::string s = " (";
     s += what;
     s += ": ";
     for (size_t i = 0; i < candidates.size(); ++i) {
         if (i) s += ", ";
-        s += candidates[i];
+        s += shown(candidates[i]);
     }
     return s + ")";
 }

@@ -1,9 +1,9 @@
 #include "kiln/shader.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cstring>
 #include <fstream>
-#include <regex>
 #include <sstream>
 
 #include "kiln/log.hpp"
@@ -37,6 +37,67 @@ bool isInside(const fs::path& root, const fs::path& p) {
     auto r = root.begin(), q = p.begin();
     for (; r != root.end(); ++r, ++q)
         if (q == p.end() || *r != *q) return false;
+    return true;
+}
+
+// Shader lines are user input of any length: they are scanned by hand, in one pass,
+// never with std::regex (whose matcher recurses per character and overflows the stack
+// on a line of some 40 000 characters).
+
+// "  #  include rest" → {"include", " rest"}; not a directive → empty name.
+struct Directive {
+    std::string_view name, rest;
+};
+Directive directiveOf(std::string_view line) {
+    size_t i = line.find_first_not_of(" \t");
+    if (i == std::string_view::npos || line[i] != '#') return {};
+    i = line.find_first_not_of(" \t", i + 1);
+    if (i == std::string_view::npos) return {};
+    size_t j = i;
+    while (j < line.size() && (std::isalnum(static_cast<unsigned char>(line[j])) || line[j] == '_')) ++j;
+    return {line.substr(i, j - i), line.substr(j)};
+}
+
+// The file name of `"name"`, optionally followed by a // comment; empty when malformed.
+std::string quotedName(std::string_view rest) {
+    const size_t open = rest.find_first_not_of(" \t");
+    if (open == std::string_view::npos || rest[open] != '"') return {};
+    const size_t close = rest.find('"', open + 1);
+    if (close == std::string_view::npos || close == open + 1) return {};
+    const size_t after = rest.find_first_not_of(" \t", close + 1);
+    if (after != std::string_view::npos && rest.substr(after, 2) != "//") return {};
+    return std::string(rest.substr(open + 1, close - open - 1));
+}
+
+// Reads the unsigned number at `s[i]`, advancing `i`; false when there is none.
+bool readNumber(std::string_view s, size_t& i, size_t& value) {
+    const size_t start = i;
+    value = 0;
+    while (i < s.size() && std::isdigit(static_cast<unsigned char>(s[i])) && i - start < 9) value = value * 10 + size_t(s[i++] - '0');
+    return i > start;
+}
+
+// A compiler log line "S:L(C): msg" (Mesa) or "S(L) : msg" (NVIDIA) → L and msg.
+bool parseLogLine(std::string_view line, size_t& lineNo, std::string& message) {
+    size_t i = 0, number = 0, column = 0;
+    if (!readNumber(line, i, number) || i >= line.size()) return false;
+    if (line[i] == ':') {  // Mesa
+        ++i;
+        if (!readNumber(line, i, lineNo) || i >= line.size() || line[i] != '(') return false;
+        ++i;
+        if (!readNumber(line, i, column) || line.substr(i, 2) != "):") return false;
+        i += 2;
+    } else if (line[i] == '(') {  // NVIDIA
+        ++i;
+        if (!readNumber(line, i, lineNo) || i >= line.size() || line[i] != ')') return false;
+        i = line.find(':', i);
+        if (i == std::string_view::npos) return false;
+        ++i;
+    } else {
+        return false;
+    }
+    const size_t text = line.find_first_not_of(" \t", i);
+    message = text == std::string_view::npos ? std::string() : std::string(line.substr(text));
     return true;
 }
 
@@ -111,14 +172,11 @@ struct Preprocessor {
         std::string line;
         int lineNo = 0;
         bool sawVersion = header == nullptr;
-        static const std::regex includeRe(R"(^\s*#\s*include\s*(.*)$)");
-        static const std::regex quotedRe(R"re(^"([^"]+)"\s*(//.*)?$)re");
-        static const std::regex versionRe(R"(^\s*#\s*version\b.*)");
         while (std::getline(lines, line)) {
             ++lineNo;
             if (!line.empty() && line.back() == '\r') line.pop_back();
-            std::smatch m;
-            if (!sawVersion && std::regex_match(line, versionRe)) {
+            const Directive directive = directiveOf(line);
+            if (!sawVersion && directive.name == "version") {
                 emit(line, id, lineNo);
                 std::istringstream defines(*header);
                 std::string define;
@@ -126,14 +184,12 @@ struct Preprocessor {
                 sawVersion = true;
                 continue;
             }
-            if (std::regex_match(line, m, includeRe)) {
-                std::string arg = m[1].str();
-                std::smatch q;
-                if (!std::regex_match(arg, q, quotedRe)) {
+            if (directive.name == "include") {
+                const std::string name = quotedName(directive.rest);
+                if (name.empty()) {
                     error = {lib.displayPath(file), lineNo, "malformed #include (expected #include \"file\")"};
                     return false;
                 }
-                const std::string name = q[1].str();
                 fs::path target;
                 std::error_code ec;
                 fs::path local = fs::weakly_canonical(file.parent_path() / name, ec);
@@ -178,22 +234,20 @@ bool ShaderLibrary::preprocess(const std::string& relativePath, const Defines& d
 
 std::vector<ShaderError> mapInfoLog(const std::string& log, const PreprocessedSource& src) {
     std::vector<ShaderError> errors;
-    static const std::regex mesaRe(R"(^(\d+):(\d+)\(\d+\):\s*(.*)$)");
-    static const std::regex nvRe(R"(^(\d+)\((\d+)\)\s*:\s*(.*)$)");
     std::istringstream lines(log);
     std::string line;
     while (std::getline(lines, line)) {
         if (line.empty()) continue;
-        std::smatch m;
-        if (std::regex_match(line, m, mesaRe) || std::regex_match(line, m, nvRe)) {
+        size_t at = 0;
+        std::string message;
+        if (parseLogLine(line, at, message)) {
             // The source-string number is ignored: the driver gets one string and
             // Mesa does not track it reliably anyway; the line table is exact.
-            const size_t at = std::stoul(m[2].str());
             if (at >= 1 && at <= src.lines.size()) {
                 const SourceLine& where = src.lines[at - 1];
-                errors.push_back({src.files[static_cast<size_t>(where.file)], where.line, m[3].str()});
+                errors.push_back({src.files[static_cast<size_t>(where.file)], where.line, message});
             } else {
-                errors.push_back({src.files.empty() ? "" : src.files[0], 0, m[3].str()});
+                errors.push_back({src.files.empty() ? "" : src.files[0], 0, message});
             }
         } else {
             errors.push_back({src.files.empty() ? "" : src.files[0], 0, line});

@@ -24,7 +24,7 @@ bool isIdentifier(std::string_view s) {
     return true;
 }
 
-std::string q(std::string_view s) { return "\"" + std::string(s) + "\""; }
+std::string q(std::string_view s) { return "\"" + elide(s) + "\""; }
 
 std::string num(double v) {
     char buf[32];

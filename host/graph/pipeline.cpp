@@ -10,6 +10,7 @@
 #include <cctype>
 #include <cstdlib>
 #include <limits>
+#include <optional>
 #include <set>
 
 namespace kiln::graph {
@@ -57,7 +58,7 @@ std::string keyPath(const std::string& parent, const std::string& key) {
     bool plain = !key.empty();
     for (char c : key)
         if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '$')) plain = false;
-    if (!plain) return parent + "[" + Json(key).dump() + "]";
+    if (!plain) return parent + "[" + elide(Json(key).dump()) + "]";
     return parent.empty() ? key : parent + "." + key;
 }
 
@@ -202,7 +203,7 @@ public:
 
     bool expect(const Json& j, Json::value_t type, const char* typeName, const std::string& path) {
         if (j.type() == type) return true;
-        error(path, std::string("expected ") + typeName + ", got " + jsonTypeName(j) + " " + j.dump());
+        error(path, std::string("expected ") + typeName + ", got " + jsonTypeName(j) + " " + elide(j.dump()));
         return false;
     }
 
@@ -240,7 +241,7 @@ public:
                     const std::string ip = keyPath(p, ii.key());
                     if (!ii.value().is_string()) {
                         error(ip, std::string("an input binding is a string \"<pass id>.<output>\", got ") +
-                                      jsonTypeName(ii.value()) + " " + ii.value().dump());
+                                      jsonTypeName(ii.value()) + " " + elide(ii.value().dump()));
                         continue;
                     }
                     pass.inputs.emplace_back(ii.key(), ii.value().get<std::string>());
@@ -297,6 +298,55 @@ std::string syntaxMessage(const std::string& what) {
         if (colon != std::string::npos) return what.substr(colon + 2);
     }
     return what;
+}
+
+// Deeper than any pipeline needs (passes[i].params.x[j] is 4): bounds the stack of
+// everything that walks the parsed value, and the size of every message about it.
+constexpr int kMaxNesting = 32;
+
+// An error at the first bracket that opens level kMaxNesting + 1 (strings skipped), or
+// nothing when the text stays within the bound.
+std::optional<Diagnostic> tooDeep(const std::string& text, const std::string& fileName) {
+    int depth = 0;
+    bool inString = false;
+    for (size_t i = 0; i < text.size(); ++i) {
+        const char c = text[i];
+        if (inString) {
+            if (c == '\\') ++i;
+            else if (c == '"') inString = false;
+        } else if (c == '"') {
+            inString = true;
+        } else if (c == '[' || c == '{') {
+            if (++depth > kMaxNesting) {
+                Diagnostic d;
+                d.file = fileName;
+                lineColumn(text, i, d.line, d.column);
+                d.message = "nested deeper than " + std::to_string(kMaxNesting) + " levels";
+                return d;
+            }
+        } else if (c == ']' || c == '}') {
+            --depth;
+        }
+    }
+    return std::nullopt;
+}
+
+// The JSON library's other refusals (a number beyond double range, 406; invalid
+// UTF-8, 316): named, located where the message quotes the text.
+Diagnostic jsonLimitError(const std::string& text, const std::string& fileName, const Json::exception& e) {
+    Diagnostic d;
+    d.file = fileName;
+    std::string what = e.what();
+    const size_t bracket = what.find("] ");
+    if (bracket != std::string::npos) what = what.substr(bracket + 2);
+    const size_t open = what.find('\''), close = what.rfind('\'');
+    if (open != std::string::npos && close > open + 1) {
+        const size_t at = text.find(what.substr(open + 1, close - open - 1));
+        if (at != std::string::npos) lineColumn(text, at, d.line, d.column);
+    }
+    if (e.id == 406) what += " (beyond the range of a double)";
+    d.message = elide(what, 160);
+    return d;
 }
 
 // nlohmann reports the *last* byte it read, i.e. the end of the offending token
@@ -383,6 +433,7 @@ Result<PipelineDesc> parsePipeline(const std::string& text, const std::string& f
     std::vector<Diagnostic> errors;
     std::vector<std::string> duplicates;
     Json root;
+    if (auto deep = tooDeep(text, fileName)) return Result<PipelineDesc>(std::move(*deep));
     try {
         DuplicateKeyFinder finder(duplicates);
         root = Json::parse(text, std::ref(finder), /*allow_exceptions=*/true, /*ignore_comments=*/false);
@@ -396,6 +447,8 @@ Result<PipelineDesc> parsePipeline(const std::string& text, const std::string& f
         if (at < text.size() && text[at] == '/')
             d.message += " (comments are not JSON: put prose in a \"note\" field)";
         return Result<PipelineDesc>(std::move(d));
+    } catch (const Json::exception& e) {
+        return Result<PipelineDesc>(jsonLimitError(text, fileName, e));
     }
 
     PipelineDesc desc;

@@ -1,10 +1,16 @@
 #include <catch2/catch.hpp>
 
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+
 #include "kiln/shader.hpp"
 #include "run/program_cache.hpp"
 #include "support/headless.hpp"
 
 using namespace kiln;
+namespace fs = std::filesystem;
 
 namespace {
 ShaderLibrary library() { return ShaderLibrary({TEST_SHADER_DIR}); }
@@ -110,4 +116,31 @@ TEST_CASE("program cache: bounded, least recently used goes, an evicted variant 
     CHECK(cache.generation() == generation + 1);
     CHECK(variant(1) != 0);
     CHECK(cache.generation() == generation + 1);  // cached now
+}
+
+TEST_CASE("shader lines of any length are parsed without recursion (regression: std::regex overflowed the stack)",
+          "[shader][robust]") {
+    const fs::path root = fs::temp_directory_path() / ("kiln-long-lines-" + std::to_string(::getpid()));
+    fs::create_directories(root);
+    const std::string huge(200000, 'x');
+    std::ofstream(root / "long_include.frag") << "#version 450 core\n#include \"" << huge << "\"\nvoid main() {}\n";
+    std::ofstream(root / "long_garbage.frag") << "#version 450 core\n#include " << huge << "\nvoid main() {}\n";
+    std::ofstream(root / "long_version.frag") << "#version 450 core " << std::string(200000, ' ') << "\nvoid main() {}\n";
+    const ShaderLibrary lib({root});
+    PreprocessedSource src;
+    ShaderError err;
+    // A 200 000-character name is no file: a named error at the line, not a crash.
+    REQUIRE_FALSE(lib.preprocess("long_include.frag", {}, src, err));
+    CHECK(err.line == 2);
+    CHECK_THAT(err.message, Catch::Contains("file not found in the shader roots"));
+    REQUIRE_FALSE(lib.preprocess("long_garbage.frag", {}, src, err));
+    CHECK(err.toString().find("long_garbage.frag:2: malformed #include") != std::string::npos);
+    CHECK(lib.preprocess("long_version.frag", {}, src, err));
+    // Compiler logs are parsed the same way: a long message line maps through the table.
+    const std::string log = "0:2(1): error: " + huge + "\n";
+    auto mapped = mapInfoLog(log, src);
+    REQUIRE(mapped.size() == 1);
+    CHECK(mapped[0].line == 2);
+    CHECK(mapped[0].message.size() == huge.size() + 7);
+    fs::remove_all(root);
 }

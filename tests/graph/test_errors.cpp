@@ -276,3 +276,43 @@ TEST_CASE("problems inside a disabled pass are warnings", "[errors]") {
     CHECK(r->warnings[0].str() ==
           "pipelines/x.json: passes[1].params.size: warning: expected int, got string \"big\" (pass is disabled)");
 }
+
+// Regressions from fuzzing the parser (issue "nothing a user types kills Kiln"): each
+// used to abort or overflow the stack; each must now be one located, bounded error.
+TEST_CASE("a number beyond double range is a located error, not an abort", "[errors][robust]") {
+    CHECK_THAT(errorsOf(withComposite("{}", R"({ "exposure": 1e999 })")),
+               Contains("pipelines/x.json:5:") && Contains("number overflow parsing '1e999' (beyond the range of a double)"));
+    CHECK_THAT(errorsOf(withComposite("{}", R"({ "exposure": -1e999 })")), Contains("number overflow"));
+    // The fuzzer's 8-byte input.
+    CHECK_THAT(errorsOf("[22E444"), Contains("pipelines/x.json:1:2: number overflow parsing '22E444'"));
+}
+
+TEST_CASE("nesting is bounded: 10^5-deep arrays give one located error, quickly", "[errors][robust]") {
+    for (const char* key : {"note", "id", "params\": {\"exposure"}) {
+        const std::string deep = std::string(100000, '[') + std::string(100000, ']');
+        const std::string json = R"({ "output": "composite.color", "passes": [ { ")" + std::string(key) + R"(": )" +
+                                 deep + (std::string(key).find('{') != std::string::npos ? "}" : "") + " } ] }";
+        const std::string e = errorsOf(json);
+        INFO(key);
+        CHECK_THAT(e, Contains("nested deeper than 32 levels"));
+        CHECK(e.size() < 200);
+    }
+    // 4 levels of pipeline + 27 = 31 are fine as JSON (the parameter is then the wrong
+    // type, said briefly).
+    const std::string ok = std::string(27, '[') + "1" + std::string(27, ']');
+    const std::string e = errorsOf(withComposite("{}", R"({ "exposure": )" + ok + " }"));
+    const size_t at = e.find("passes[3].params.exposure");
+    REQUIRE(at != std::string::npos);
+    const std::string line = e.substr(at, e.find('\n', at) - at);
+    INFO(line);
+    CHECK(line.size() < 200);  // the value is shown elided to 80 bytes
+}
+
+TEST_CASE("user text in messages is cut short: a megabyte id does not make a megabyte message", "[errors][robust]") {
+    const std::string longId(1000000, 'A');
+    const std::string e = errorsOf(R"({ "output": "composite.color", "passes": [ { "id": ")" + longId +
+                                   R"(", "module": "gbuffer" } ] })");
+    CHECK_THAT(e, Contains("bad id \"AAAA"));
+    CHECK_THAT(e, Contains("…(+"));
+    CHECK(e.size() < 2000);
+}
