@@ -1,9 +1,12 @@
 #include "kiln/module_loader.hpp"
 
 #include <dlfcn.h>
+#include <elf.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cstring>
+#include <fstream>
 
 #include "kiln/names.hpp"
 #include "kiln/log.hpp"
@@ -62,6 +65,46 @@ std::string joined(const std::vector<std::string>& v) {
     for (auto& x : v) s += (s.empty() ? "" : ", ") + x;
     return s.empty() ? "none" : s;
 }
+
+// dlopen maps a file's segments as its headers say; a file cut short (an interrupted
+// build, `truncate`) then faults with SIGBUS on first touch, inside dlopen. So the
+// headers are checked against the file's real size first: a 64-bit ELF shared object
+// whose program headers, loadable segments and section headers all lie inside it.
+bool checkElf(const fs::path& file, std::string& error) {
+    std::ifstream in(file, std::ios::binary);
+    std::error_code ec;
+    const uint64_t size = fs::file_size(file, ec);
+    Elf64_Ehdr eh{};
+    if (!in || ec || size < sizeof eh || !in.read(reinterpret_cast<char*>(&eh), sizeof eh)) {
+        error = "not a shared library (" + std::to_string(ec ? 0 : size) + " bytes, no ELF header)";
+        return false;
+    }
+    if (std::memcmp(eh.e_ident, ELFMAG, SELFMAG) != 0 || eh.e_ident[EI_CLASS] != ELFCLASS64 || eh.e_type != ET_DYN) {
+        error = "not a 64-bit ELF shared library";
+        return false;
+    }
+    auto inside = [&](uint64_t offset, uint64_t count, uint64_t each) {
+        return offset <= size && count <= (size - offset) / std::max<uint64_t>(each, 1);
+    };
+    if (eh.e_phentsize != sizeof(Elf64_Phdr) || !inside(eh.e_phoff, eh.e_phnum, sizeof(Elf64_Phdr)) ||
+        !inside(eh.e_shoff, eh.e_shnum, eh.e_shentsize)) {
+        error = "truncated: its headers reach past the end of the file (" + std::to_string(size) +
+                " bytes; an interrupted build?)";
+        return false;
+    }
+    in.seekg(static_cast<std::streamoff>(eh.e_phoff));
+    for (int i = 0; i < eh.e_phnum; ++i) {
+        Elf64_Phdr ph{};
+        if (!in.read(reinterpret_cast<char*>(&ph), sizeof ph)) break;
+        if (ph.p_type == PT_LOAD && !inside(ph.p_offset, ph.p_filesz, 1)) {
+            error = "truncated: segment " + std::to_string(i) + " ends at byte " +
+                    std::to_string(ph.p_offset + ph.p_filesz) + " of a " + std::to_string(size) +
+                    "-byte file (an interrupted build?)";
+            return false;
+        }
+    }
+    return true;
+}
 }  // namespace
 
 std::shared_ptr<LoadedModule> ModuleLoader::load(const std::string& name, std::string& error) {
@@ -97,7 +140,13 @@ std::shared_ptr<LoadedModule> ModuleLoader::load(const std::string& name, std::s
     auto module = std::shared_ptr<LoadedModule>(new LoadedModule());
     module->name_ = name;
     module->source_ = source;
-    module->loadedCopy_ = copy;
+    module->loadedCopy_ = copy;  // removed by ~LoadedModule, loaded or not
+    // The copy is what dlopen maps, so the copy is what is checked.
+    std::string why;
+    if (!checkElf(copy, why)) {
+        error = source.string() + ": cannot load: " + why;
+        return nullptr;
+    }
     module->handle_ = dlopen(copy.c_str(), RTLD_NOW | RTLD_LOCAL);
     if (!module->handle_) {
         const char* why = dlerror();

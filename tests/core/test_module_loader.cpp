@@ -1,6 +1,10 @@
 #include <catch2/catch.hpp>
 
 #include <dlfcn.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
 
 #include "kiln/module_loader.hpp"
 
@@ -75,4 +79,37 @@ TEST_CASE("module loader loads a private copy, so two loads are two libraries", 
     REQUIRE(b);
     // Different code addresses: dlopen did not hand back the cached first library.
     CHECK(reinterpret_cast<const void*>(a->descriptor().create) != reinterpret_cast<const void*>(b->descriptor().create));
+}
+
+// What an interrupted build leaves (`truncate -s 4096 libpass_x.so`), an empty file and
+// plain garbage: each is refused with a named error before dlopen, which would otherwise
+// die of SIGBUS touching a segment past the end of the file.
+TEST_CASE("module loader: truncated, empty and garbage files are refused before dlopen", "[loader][robust]") {
+    namespace fs = std::filesystem;
+    const fs::path dir = fs::temp_directory_path() / ("kiln-bad-modules-" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    const fs::path good = fs::path(TEST_MODULE_DIR) / "libpass_test_good.so";
+    const auto size = fs::file_size(good);
+    REQUIRE(size > 16384);
+    struct Case { const char* name; uintmax_t keep; const char* expect; };
+    for (const Case c : {Case{"cut_4096", 4096, "truncated"}, Case{"cut_half", size / 2, "truncated"},
+                         Case{"cut_header", 40, "no ELF header"}, Case{"empty", 0, "no ELF header"}}) {
+        const fs::path file = dir / ("libpass_" + std::string(c.name) + ".so");
+        fs::copy_file(good, file, fs::copy_options::overwrite_existing);
+        fs::resize_file(file, c.keep);
+        ModuleLoader loader({dir});
+        std::string error;
+        INFO(c.name);
+        CHECK_FALSE(loader.load(c.name, error));
+        CHECK_THAT(error, Catch::Contains(file.string() + ": cannot load: ") && Catch::Contains(c.expect));
+    }
+    std::ofstream(dir / "libpass_garbage.so") << std::string(8192, 'x');
+    ModuleLoader loader({dir});
+    std::string error;
+    CHECK_FALSE(loader.load("garbage", error));
+    CHECK_THAT(error, Catch::Contains("not a 64-bit ELF shared library"));
+    // The intact file still loads from the same directory.
+    fs::copy_file(good, dir / "libpass_test_good.so", fs::copy_options::overwrite_existing);
+    CHECK(loader.load("test_good", error));
+    fs::remove_all(dir);
 }
