@@ -24,6 +24,7 @@ bool App::init(const Options& o, std::string& error) {
     if (!runtime_.init(ro, error)) return false;
     if (!scene_.load(o.scene, seedOverride(), error)) return false;
     if (!viewed.empty()) runtime_.setRequested({viewed});
+    requestedView_ = viewed;
     std::string errors;
     if (!runtime_.loadPipeline(o.pipeline, errors)) {
         if (!errors.empty() && errors.back() == '\n') errors.pop_back();
@@ -87,6 +88,10 @@ SceneView App::buildView() {
 
 void App::frame() {
     live_.poll(*this);  // edits land at a frame boundary, on this thread
+    if (viewed != requestedView_) {
+        requestedView_ = viewed;
+        runtime_.setRequested(viewed.empty() ? std::vector<std::string>{} : std::vector<std::string>{viewed});
+    }
     if (!paused || singleStep) {
         scene_.step();
         ++timeVersion_;

@@ -37,7 +37,9 @@ public:
     std::optional<uint64_t> seedOverride() const;
     bool paused = false;
     bool singleStep = false;
-    std::string viewed;  // "pass.output" or empty for the graph output
+    // "pass.output" or empty for the graph output. Viewing a texture un-culls its
+    // producer (from the next frame on), as --view does.
+    std::string viewed;
 
 private:
     SceneView buildView();
@@ -51,6 +53,7 @@ private:
     uint64_t frameIndex_ = 0;
     glm::mat4 lastViewProj_{0.0f};
     uint64_t cameraVersion_ = 0, timeVersion_ = 0;
+    std::string requestedView_;  // what the runtime was last asked to keep un-culled
 };
 
 int runWindow(const Options&);

@@ -71,7 +71,12 @@ void panelParams(App& app, PipelineEditor& editor) {
     if (!plan) return;
     int index = plan->find(editor.selected);
     if (index < 0) return;
-    const graph::PlannedPass& pass = plan->passes[static_cast<size_t>(index)];
+    // A copy: an edit below swaps the running plan, and with it this pass's entry.
+    const graph::PlannedPass pass = plan->passes[static_cast<size_t>(index)];
+    // Widget ids are scoped to the pass, so "exposure" here is not the texture
+    // panel's display "exposure".
+    ImGui::PushID("params");
+    ImGui::PushID(pass.id.c_str());
     ImGui::Separator();
     ImGui::Text("%s parameters", pass.id.c_str());
     for (auto& decl : pass.decl.params) {
@@ -113,8 +118,10 @@ void panelParams(App& app, PipelineEditor& editor) {
             case ParamType::Color: changed = ImGui::ColorEdit3(label, std::get<Color3>(edited).data()); break;
         }
         if (!decl.doc.empty() && ImGui::IsItemHovered()) ImGui::SetTooltip("%s", decl.doc.c_str());
-        if (changed)
+        if (changed) {
             editor.apply(app, [&](graph::PipelineDesc& d) { setParam(d.passes[size_t(d.find(pass.id))], decl.name, edited); });
+            break;  // the next frame draws the widgets of the new plan
+        }
     }
     if (ImGui::Button("write back to the pipeline file")) {
         std::FILE* f = std::fopen(app.runtime().pipelineFile().c_str(), "w");
@@ -125,6 +132,8 @@ void panelParams(App& app, PipelineEditor& editor) {
             std::fclose(f);
         }
     }
+    ImGui::PopID();
+    ImGui::PopID();
 }
 
 void panelPasses(App& app, PipelineEditor& editor) {
@@ -156,13 +165,17 @@ void panelPasses(App& app, PipelineEditor& editor) {
         ImGui::TableNextColumn();
         ImGui::TextUnformatted(r.state.c_str());
         if (!r.why.empty() && ImGui::IsItemHovered()) ImGui::SetTooltip("%s", r.why.c_str());
+        // What ran this frame costs its rolling average; a skipped, culled or disabled
+        // pass costs nothing and shows a dash, never its last figure.
         ImGui::TableNextColumn();
-        if (r.gpuMs >= 0) ImGui::Text("%.3f", r.gpuMs), gpuTotal += r.gpuMs;
+        if (r.ranThisFrame && r.gpuMs >= 0) ImGui::Text("%.3f", r.gpuMs), gpuTotal += r.gpuMs;
+        else ImGui::TextDisabled("-");
         ImGui::TableNextColumn();
-        if (r.ranFrames) ImGui::Text("%.3f", r.cpuMs), cpuTotal += r.cpuMs;
+        if (r.ranThisFrame) ImGui::Text("%.3f", r.cpuMs), cpuTotal += r.cpuMs;
+        else ImGui::TextDisabled("-");
     }
     ImGui::EndTable();
-    ImGui::Text("total: GPU %.2f ms, CPU %.2f ms (rolling averages)", gpuTotal, cpuTotal);
+    ImGui::Text("this frame: GPU %.2f ms, CPU %.2f ms (rolling averages of what ran)", gpuTotal, cpuTotal);
     if (!editor.error.empty()) ImGui::TextColored(ImVec4(1, 0.4f, 0.4f, 1), "%s", editor.error.c_str());
     panelParams(app, editor);
 }
@@ -178,6 +191,7 @@ void panelTextures(App& app, DisplaySettings& d) {
                             " " + gl::formatName(t.ref.format);
         if (ImGui::RadioButton(label.c_str(), app.viewed == name)) app.viewed = name;
     }
+    ImGui::PushID("display");
     const char* channels[] = {"RGB", "R", "G", "B", "A"};
     ImGui::Combo("channel", &d.channel, channels, 5);
     ImGui::DragFloatRange2("range", &d.rangeMin, &d.rangeMax, 0.01f, -100.0f, 100.0f);
@@ -187,6 +201,7 @@ void panelTextures(App& app, DisplaySettings& d) {
     const char* axes[] = {"x", "y", "z"};
     ImGui::Combo("3D axis", &d.axis, axes, 3);
     ImGui::SliderFloat("3D slice", &d.slice, 0.0f, 1.0f);
+    ImGui::PopID();
 }
 
 void panelErrors(App& app) {

@@ -59,6 +59,7 @@ PassRow PassTimings::row(const std::string& id, const std::string& module) const
     r.cpuMedianMs = cpu_.empty() ? 0.0 : median(cpu_);
     r.ranFrames = ranFrames;
     r.skippedFrames = skippedFrames;
+    r.ranThisFrame = state == "ran" || state == "nothing to do";
     return r;
 }
 

@@ -19,6 +19,7 @@ struct PassRow {
     double cpuMs = 0.0;
     double gpuMedianMs = -1.0, cpuMedianMs = 0.0;
     int ranFrames = 0, skippedFrames = 0;
+    bool ranThisFrame = false;  // ran or nothing to do; skipped/culled/disabled/error cost 0
 };
 
 class PassTimings {

@@ -126,8 +126,27 @@ TEST_CASE("viewing a culled pass's texture un-culls it without renewing other te
     };
     CHECK(stateOf("spare") == "culled");
     const GLuint color = f.texture("composite", "color");
-    f.app.runtime().setRequested({"spare.normal"});
+    // Selecting the texture in the window (App::viewed) is enough, as --view is.
+    f.app.viewed = "spare.normal";
     f.app.frame();
     CHECK(stateOf("spare") == "ran");
     CHECK(f.texture("composite", "color") == color);
+    f.app.viewed.clear();
+    f.app.frame();
+    CHECK(stateOf("spare") == "culled");
+}
+
+TEST_CASE("a pass that did not run this frame reports no cost this frame", "[runtime][gl]") {
+    Fixture f;
+    f.app.frame();
+    for (auto& r : f.app.runtime().stats()) {
+        INFO(r.id);
+        CHECK(r.ranThisFrame);
+    }
+    f.app.frame();  // paused: everything skips
+    for (auto& r : f.app.runtime().stats()) {
+        INFO(r.id << " " << r.state);
+        CHECK(r.state == "skipped");
+        CHECK_FALSE(r.ranThisFrame);
+    }
 }
