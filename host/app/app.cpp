@@ -47,9 +47,19 @@ bool App::init(const Options& o, std::string& error) {
 
 void App::resize(int width, int height) {
     if (width < 1 || height < 1 || (width == options_.width && height == options_.height)) return;
+    if (width == refusedWidth_ && height == refusedHeight_) return;  // said once already
+    std::string error;
+    if (!runtime_.resize(width, height, error)) {
+        refusedWidth_ = width, refusedHeight_ = height;
+        if (!error.empty() && error.back() == '\n') error.pop_back();
+        log::error(error);
+        runtime_.setExternalError("resize", error + " (rendering stays at " + std::to_string(options_.width) + "x" +
+                                                std::to_string(options_.height) + ")");
+        return;
+    }
+    runtime_.setExternalError("resize", "");
     options_.width = width;
     options_.height = height;
-    runtime_.resize(width, height);
 }
 
 std::optional<uint64_t> App::seedOverride() const {

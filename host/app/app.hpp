@@ -54,6 +54,7 @@ private:
     glm::mat4 lastViewProj_{0.0f};
     uint64_t cameraVersion_ = 0, timeVersion_ = 0;
     std::string requestedView_;  // what the runtime was last asked to keep un-culled
+    int refusedWidth_ = 0, refusedHeight_ = 0;  // a size the runtime refused
 };
 
 int runWindow(const Options&);

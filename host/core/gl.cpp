@@ -1,6 +1,7 @@
 #include "kiln/gl.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 
 #include "kiln/log.hpp"
@@ -14,6 +15,8 @@ int loadGL(GLADloadfunc getProc) {
 }
 
 namespace {
+std::atomic<uint64_t> gErrors{0};
+
 void GLAPIENTRY onDebugMessage(GLenum source, GLenum type, GLuint id, GLenum severity, GLsizei,
                                const GLchar* message, const void*) {
     // Compile errors come back through buildProgram(), mapped to file:line.
@@ -21,12 +24,15 @@ void GLAPIENTRY onDebugMessage(GLenum source, GLenum type, GLuint id, GLenum sev
     if (severity == GL_DEBUG_SEVERITY_NOTIFICATION) return;
     if (type == GL_DEBUG_TYPE_PUSH_GROUP || type == GL_DEBUG_TYPE_POP_GROUP) return;
     const bool isError = type == GL_DEBUG_TYPE_ERROR || severity == GL_DEBUG_SEVERITY_HIGH;
+    if (type == GL_DEBUG_TYPE_ERROR) ++gErrors;
     if (isError)
         log::error("GL [", id, "] ", message);
     else
         log::warn("GL [", id, "] ", message);
 }
 }  // namespace
+
+uint64_t debugErrorCount() { return gErrors.load(); }
 
 void installDebugCallback() {
     if (!glDebugMessageCallback) return;

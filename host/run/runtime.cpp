@@ -40,6 +40,7 @@ bool Runtime::init(const RuntimeOptions& options, std::string& error) {
     glCreateVertexArrays(1, &vao);
     emptyVao_ = gl::VertexArrayHandle(vao);
     fallbacks_.create();
+    limits_ = TextureLimits::query(options.textureBudgetBytes);
     return true;
 }
 
@@ -62,6 +63,10 @@ bool Runtime::loadPipelineText(const std::string& text, const std::string& displ
     auto result = graph::compileText(text, displayName, opt);
     if (!result) {
         errors = result.errorText();
+        return false;
+    }
+    if (std::string tooLarge = checkTextureLimits(*result, options_.width, options_.height, limits_); !tooLarge.empty()) {
+        errors = tooLarge;
         return false;
     }
     for (auto& w : result->warnings) log::warn(w.str());
@@ -155,13 +160,19 @@ void Runtime::allocateTextures(size_t i) {
     if (changed) slot.invalidate(true);
 }
 
-void Runtime::resize(int width, int height) {
-    if (width == options_.width && height == options_.height) return;
-    options_.width = std::max(1, width);
-    options_.height = std::max(1, height);
-    if (!plan_) return;
+bool Runtime::resize(int width, int height, std::string& error) {
+    width = std::max(1, width), height = std::max(1, height);
+    if (width == options_.width && height == options_.height) return true;
+    if (plan_) {
+        error = checkTextureLimits(*plan_, width, height, limits_);
+        if (!error.empty()) return false;  // the textures keep their size
+    }
+    options_.width = width;
+    options_.height = height;
+    if (!plan_) return true;
     // In order: a texture sized from an input follows its producer's new size.
     for (size_t i = 0; i < slots_.size(); ++i) allocateTextures(i);
+    return true;
 }
 
 std::vector<uint64_t> Runtime::runKey(const graph::PlannedPass& planned, const PassSlot& slot,

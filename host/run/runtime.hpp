@@ -27,6 +27,7 @@ struct RuntimeOptions {
     std::vector<std::filesystem::path> shaderRoots;
     std::vector<std::filesystem::path> moduleDirs;
     int width = 720, height = 720;
+    uint64_t textureBudgetBytes = 8ull << 30;  // all textures of a plan together
 };
 
 class Runtime {
@@ -43,7 +44,9 @@ public:
     // Textures the debug view shows or --dump wants ("pass.output"): un-culls their
     // producers without touching anyone's textures.
     void setRequested(std::vector<std::string> requested);
-    void resize(int width, int height);
+    // New output size; refused (textures unchanged, `error` says why) when the plan's
+    // textures would not fit the GL limits or the budget at that size.
+    bool resize(int width, int height, std::string& error);
 
     void renderFrame(const SceneView& view, const SceneDraw& scene, const FrameInfo& frame);
     // Harvests finished GPU timer queries (renderFrame does it each frame; call after
@@ -102,6 +105,7 @@ private:
     gl::Buffer frameUniforms_;
     gl::VertexArrayHandle emptyVao_;
     FallbackTextures fallbacks_;
+    TextureLimits limits_;
     uint64_t versionCounter_ = 0;
     std::map<std::string, std::string> externalErrors_;
 };

@@ -26,6 +26,65 @@ GLenum glFormat(Format f) {
 
 bool isFloatFormat(GLenum f) { return f != GL_RGBA8 && f != GL_R32UI; }
 
+size_t bytesPerTexel(Format f) {
+    switch (f) {
+        case Format::RGBA32F: return 16;
+        case Format::RGBA16F: return 8;
+        case Format::R16F: return 2;
+        default: return 4;
+    }
+}
+
+TextureLimits TextureLimits::query(uint64_t budgetBytes) {
+    TextureLimits l;
+    glGetIntegerv(GL_MAX_TEXTURE_SIZE, &l.max2D);
+    glGetIntegerv(GL_MAX_3D_TEXTURE_SIZE, &l.max3D);
+    l.budgetBytes = budgetBytes;
+    return l;
+}
+
+namespace {
+
+uint64_t bytesOf(const TextureDecl& d, graph::Extent e) {
+    const bool is3D = d.kind == TextureKind::Color3D;
+    const int levels = d.mips == kFullMipChain ? gl::Texture::fullMipCount(e.w, e.h, is3D ? e.d : 1) : std::max(1, d.mips);
+    uint64_t total = 0;
+    for (int l = 0; l < levels; ++l)
+        total += uint64_t(std::max(1, e.w >> l)) * uint64_t(std::max(1, e.h >> l)) *
+                 uint64_t(is3D ? std::max(1, e.d >> l) : 1);
+    return total * bytesPerTexel(d.format);
+}
+
+std::string mib(uint64_t bytes) { return std::to_string((bytes + (1u << 20) - 1) >> 20) + " MiB"; }
+
+}  // namespace
+
+std::string checkTextureLimits(const graph::Plan& plan, int outW, int outH, const TextureLimits& limits) {
+    std::string problems;
+    uint64_t total = 0;
+    for (size_t i = 0; i < plan.passes.size(); ++i) {
+        const graph::PlannedPass& p = plan.passes[i];
+        if (p.state == graph::PassState::Disabled) continue;
+        auto check = [&](const TextureDecl& d) {
+            const graph::Extent e = plan.extentOf(int(i), d.name, outW, outH);
+            const bool is3D = d.kind == TextureKind::Color3D;
+            const int limit = is3D ? limits.max3D : limits.max2D;
+            const std::string size = std::to_string(e.w) + "x" + std::to_string(e.h) + (is3D ? "x" + std::to_string(e.d) : "");
+            if (std::max({e.w, e.h, is3D ? e.d : 0}) > limit)
+                problems += plan.fileName + ": passes[" + std::to_string(i) + "] (" + p.id + "): texture \"" + d.name +
+                            "\" would be " + size + ", beyond this GL's " + (is3D ? "GL_MAX_3D_TEXTURE_SIZE " : "GL_MAX_TEXTURE_SIZE ") +
+                            std::to_string(limit) + "\n";
+            total += bytesOf(d, e);
+        };
+        for (auto& d : p.decl.outputs) check(d);
+        for (auto& d : p.decl.internals) check(d);
+    }
+    if (total > limits.budgetBytes)
+        problems += plan.fileName + ": its textures would take " + mib(total) + " at " + std::to_string(outW) + "x" +
+                    std::to_string(outH) + ", over the texture budget of " + mib(limits.budgetBytes) + "\n";
+    return problems;
+}
+
 namespace {
 
 void clearToDefault(const gl::Texture& t) {

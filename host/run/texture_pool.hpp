@@ -18,6 +18,21 @@ namespace kiln::run {
 
 GLenum glFormat(Format);
 bool isFloatFormat(GLenum internalFormat);
+size_t bytesPerTexel(Format);
+
+// What the host refuses to allocate: a side beyond the GL limits, or a plan whose
+// textures together exceed the budget (a pipeline asking for 4096³ voxels gets a named
+// error, not an out-of-memory kill).
+struct TextureLimits {
+    int max2D = 16384, max3D = 2048;     // GL_MAX_TEXTURE_SIZE, GL_MAX_3D_TEXTURE_SIZE
+    uint64_t budgetBytes = 8ull << 30;   // all textures of a plan together
+    static TextureLimits query(uint64_t budgetBytes);
+};
+
+// Checks every texture of every pass that is not disabled at an output size of
+// outW×outH; "" when all fit, else one line per problem naming the pass, the texture,
+// its size and the limit.
+std::string checkTextureLimits(const graph::Plan&, int outW, int outH, const TextureLimits&);
 
 struct PooledTexture {
     TextureDecl decl;

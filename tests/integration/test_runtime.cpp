@@ -150,3 +150,45 @@ TEST_CASE("a pass that did not run this frame reports no cost this frame", "[run
         CHECK_FALSE(r.ranThisFrame);
     }
 }
+
+TEST_CASE("textures beyond the budget or the GL limits are a named error and the running plan stays",
+          "[runtime][gl][robust]") {
+    REQUIRE(test::ensureHeadlessContext());
+    app::Options o = test::pausedHeadlessOptions(64);
+    run::RuntimeOptions ro;
+    ro.shaderRoots = {o.shaderRoot};
+    ro.moduleDirs = {o.moduleDir};
+    ro.width = ro.height = 64;
+    // The default pipeline at 64² needs ≈ 28 MiB (a 2048² depth map is 16 MiB, the 64³
+    // volumes with mips ≈ 11 MiB); a 48 MiB budget holds it, but not its variant with a
+    // 4096² shadow map (+ 48 MiB) nor the same plan at 4096² (a 4096² RGBA16F is 128 MiB).
+    ro.textureBudgetBytes = 48ull << 20;
+    run::Runtime rt;
+    std::string error;
+    REQUIRE(rt.init(ro, error));
+    INFO(error);
+    REQUIRE(rt.loadPipeline(std::string(KILN_SOURCE_DIR) + "/pipelines/default.json", error));
+    const graph::Plan* before = rt.plan();
+    const std::string text = rt.pipelineText();
+    std::string big = text;
+    const std::string from = R"("params": { "size": 2048 })";
+    const size_t at = big.find(from);
+    REQUIRE(at != std::string::npos);
+    big.replace(at, from.size(), R"("params": { "size": 4096 })");
+    std::string errors;
+    CHECK_FALSE(rt.loadPipelineText(big, "big.json", errors));
+    CHECK_THAT(errors, Catch::Contains("big.json: its textures would take") && Catch::Contains("over the texture budget of 48 MiB"));
+    CHECK(rt.plan() == before);
+    CHECK(rt.pipelineText() == text);
+    // A resize past the budget is refused; the textures keep their size.
+    CHECK_FALSE(rt.resize(4096, 4096, errors));
+    CHECK_THAT(errors, Catch::Contains("over the texture budget"));
+    CHECK(rt.findTexture("gbuffer", "albedo")->width == 64);
+    // Past GL_MAX_TEXTURE_SIZE (16384 on llvmpipe) whatever the budget.
+    GLint max2D = 0;
+    glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max2D);
+    CHECK_FALSE(rt.resize(max2D + 1, 8, errors));
+    CHECK_THAT(errors, Catch::Contains("beyond this GL's GL_MAX_TEXTURE_SIZE " + std::to_string(max2D)));
+    CHECK(rt.resize(80, 80, errors));
+    CHECK(rt.findTexture("gbuffer", "albedo")->width == 80);
+}

@@ -21,6 +21,9 @@ int loadGL(GLADloadfunc getProc);
 // Routes KHR_debug messages to the log (errors and performance warnings; the
 // notification chatter is dropped).
 void installDebugCallback();
+// GL_DEBUG_TYPE_ERROR messages seen since start (the debug callback counts them): the
+// tests and the soak run assert that Kiln causes none.
+uint64_t debugErrorCount();
 
 // Names a GL object for RenderDoc/apitrace (glObjectLabel), when KHR_debug is present.
 void label(GLenum identifier, GLuint name, std::string_view text);
