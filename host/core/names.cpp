@@ -34,15 +34,18 @@ int editDistance(std::string_view a, std::string_view b) {
     return prev[m];
 }
 
+std::string elide(std::string_view s, size_t max) {
+    if (s.size() <= max) return std::string(s);
+    return std::string(s.substr(0, max)) + "…(+" + std::to_string(s.size() - max) + " bytes)";
+}
+
 namespace {
-// Names in messages are user text: shown at most this long.
+// Names in suggestions: shown at most this long.
 constexpr size_t kShownNameLength = 48;
 // Longer than this, a name is no typo of anything (and the O(n·m) distance is skipped).
 constexpr size_t kSuggestableLength = 256;
 
-std::string shown(std::string_view s) {
-    return s.size() <= kShownNameLength ? std::string(s) : std::string(s.substr(0, kShownNameLength)) + "…";
-}
+std::string shown(std::string_view s) { return elide(s, kShownNameLength); }
 }  // namespace
 
 std::string nearestName(std::string_view name, const std::vector<std::string>& candidates) {

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "kiln/log.hpp"
+#include "kiln/names.hpp"
 
 namespace fs = std::filesystem;
 
@@ -200,7 +201,7 @@ struct Preprocessor {
                 else
                     target = lib.resolve(name);
                 if (target.empty()) {
-                    error = {lib.displayPath(file), lineNo, "#include \"" + name + "\": file not found in the shader roots"};
+                    error = {lib.displayPath(file), lineNo, "#include \"" + elide(name) + "\": file not found in the shader roots"};
                     return false;
                 }
                 if (!include(target, nullptr)) return false;

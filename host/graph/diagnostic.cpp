@@ -19,9 +19,4 @@ std::string toString(const std::vector<Diagnostic>& ds) {
     return s;
 }
 
-std::string elide(std::string_view s, size_t max) {
-    if (s.size() <= max) return std::string(s);
-    return std::string(s.substr(0, max)) + "…(+" + std::to_string(s.size() - max) + " bytes)";
-}
-
 }  // namespace kiln::graph

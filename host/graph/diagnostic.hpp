@@ -37,10 +37,6 @@ struct Diagnostic {
 // Prints one diagnostic per line.
 std::string toString(const std::vector<Diagnostic>&);
 
-// User text quoted in a message, cut to `max` bytes: "abc…(+99994 bytes)". Keeps every
-// message short whatever the file holds (a 1 MB id, a 10⁴-deep array).
-std::string elide(std::string_view s, size_t max = 80);
-
 // A value or the errors that prevented it. Never both, never neither.
 template <class T>
 class Result {

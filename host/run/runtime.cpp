@@ -45,6 +45,11 @@ bool Runtime::init(const RuntimeOptions& options, std::string& error) {
 }
 
 bool Runtime::loadPipeline(const fs::path& file, std::string& errors) {
+    std::error_code ec;
+    if (fs::is_directory(file, ec)) {
+        errors = file.string() + ": is a directory, not a pipeline file";
+        return false;
+    }
     std::ifstream in(file, std::ios::binary);
     if (!in) {
         errors = file.string() + ": cannot read pipeline file";

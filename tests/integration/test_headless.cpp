@@ -12,36 +12,12 @@
 #include "app/app.hpp"
 #include "kiln/image_io.hpp"
 #include "support/headless.hpp"
+#include "support/run_kiln.hpp"
 
 namespace fs = std::filesystem;
 using namespace kiln;
-
-namespace {
-
-struct Run {
-    int exitCode = -1;
-    std::string out, err;
-};
-
-std::string slurp(const fs::path& p) {
-    std::ifstream in(p);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
-Run runKiln(const std::string& args) {
-    // ctest runs test cases in parallel processes: every run gets its own files.
-    static int serial = 0;
-    fs::create_directories(TEST_OUTPUT_DIR);
-    const std::string base = std::string(TEST_OUTPUT_DIR) + "/run-" + std::to_string(getpid()) + "-" + std::to_string(++serial);
-    const std::string out = base + ".out", err = base + ".err";
-    const std::string cmd = std::string(KILN_BINARY) + " " + args + " > " + out + " 2> " + err;
-    int status = std::system(cmd.c_str());
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out), slurp(err)};
-}
-
-}  // namespace
+using kiln::test::Run;
+using kiln::test::runKiln;
 
 TEST_CASE("default pipeline: left wall reads orange, right wall sky blue", "[integration][gl]") {
     REQUIRE(test::ensureHeadlessContext());

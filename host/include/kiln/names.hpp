@@ -17,6 +17,10 @@ inline constexpr std::size_t kMaxNameLength = 64;
 inline constexpr const char* kNameRule = "[a-z0-9_]+ (at most 64 characters)";
 bool isValidName(std::string_view s);
 
+// User text quoted in a message, cut to `max` bytes: "abc…(+99994 bytes)". Keeps every
+// message short whatever a file holds (a 1 MB id, a 60 000-character #include).
+std::string elide(std::string_view s, size_t max = 80);
+
 
 // Edit distance with adjacent transpositions, case-insensitive.
 int editDistance(std::string_view a, std::string_view b);
