@@ -8,8 +8,8 @@
 //   if (!r) { std::cerr << r.error.toString("scenes/cornell.json") << "\n"; return 1; }
 //   kiln::sim::World world(r.scene);
 //   each frame (unless paused): world.step();          // dt = scene.physics.dt
-//   if (world.bodiesVersion() != seen) upload tumblers()/balls() (or the *Instances()
-//   float arrays below); likewise particlesVersion() for particles().
+//   if (world.bodiesVersion() != seen) upload tumblers()/balls() (the host writes its
+//   own instance records from them); likewise particlesVersion() for particles().
 //
 // Model (SPEC §4): a tumbler's lower-sphere centre O stays at y = −1 + b and it rolls
 // without slipping; "seed" mode puts the centre of mass at O and adds the seed's
@@ -44,6 +44,9 @@ public:
     double uniform(double lo, double hi) { return lo + (hi - lo) * uniform(); }
     Vec3 inUnitBall();
     Vec3 onUnitSphere();
+    // The generator's full state (for World::stateHash).
+    uint64_t state() const { return state_; }
+    uint64_t stream() const { return inc_; }
 
 private:
     uint64_t state_ = 0, inc_ = 0;
@@ -97,29 +100,6 @@ struct Particle {
     Vec3 emission() const;
 };
 
-// GPU-ready instance records (float, tightly packed, 16-byte multiples) written by
-// World::write*Instances; upload the vector's data() as an instance buffer.
-struct TumblerInstance {
-    float model[16];      // column-major model matrix (local → world)
-    float color[3];
-    uint32_t asleep;      // 1 when the tumbler sleeps
-};
-struct BallInstance {
-    float position[3];
-    float radius;
-    float albedo[3];
-    uint32_t kind;        // BallKind
-    float emissive[3];    // colour, multiply by strength
-    float strength;
-};
-struct ParticleInstance {
-    float position[3];
-    float radius;
-    float emission[3];    // emitted radiance (already scaled)
-    uint32_t kind;        // ParticleKind
-};
-static_assert(sizeof(TumblerInstance) == 80 && sizeof(BallInstance) == 48 && sizeof(ParticleInstance) == 32);
-
 // Solves K·j = Δv for a symmetric positive semi-definite 3×3 K (an effective-mass
 // matrix, K = (1/m)𝟙 − [r]×I⁻¹[r]×). When K is singular or nearly so (relative to its
 // scale) it returns the minimum-norm least-squares solution (pseudo-inverse, eigenvalues
@@ -156,11 +136,6 @@ public:
     std::vector<Ball>& balls() { return balls_; }
     const std::vector<Ball>& balls() const { return balls_; }
     const std::vector<Particle>& particles() const { return particles_; }
-
-    // Contiguous float records for instanced drawing (cleared, then filled).
-    void writeTumblerInstances(std::vector<TumblerInstance>& out) const;
-    void writeBallInstances(std::vector<BallInstance>& out) const;
-    void writeParticleInstances(std::vector<ParticleInstance>& out) const;
 
     // The particle pool's size: particles_ never grows beyond it (no reallocation).
     static constexpr size_t kMaxParticles = 4096;
@@ -209,7 +184,8 @@ public:
     Vec3 centreOfMass(int i) const;
     double tumblerMass() const { return scene_.tumblerShape.mass; }
 
-    // FNV-1a over the raw state (bodies, balls, particles, RNG, time).
+    // FNV-1a over all of the state: every field of every tumbler, ball and particle,
+    // the generator, time, step count and the drag in progress.
     uint64_t stateHash() const;
 
     // A ball's modified mechanical energy per unit mass in free flight,

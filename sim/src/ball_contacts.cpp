@@ -1,0 +1,173 @@
+// ball_contacts.cpp — balls: free flight with time-symmetric wall bounces, the lamp dome,
+// tumblers (swept for fast balls) and each other (uniform-grid broad phase).
+#include "internal.hpp"
+
+namespace kiln::sim {
+
+using namespace detail;
+
+void World::stepBall(Ball& ball, double dt) {
+    const double gy = ball.kind == BallKind::Fireball ? 0.0 : -scene_.physics.gravity;
+    const Vec3 v0 = ball.velocity, x0 = ball.position;
+    Vec3 v1 = v0;
+    v1.y += gy * dt;
+    Vec3 x1 = x0 + v1 * dt;
+    const double limit = 1.0 - ball.radius;
+    for (int k = 0; k < 3; ++k) {
+        if (std::abs(x1[k]) <= limit) continue;
+        // Time-symmetric bounce: a step that would cross the wall becomes the time
+        // reverse of the step that came in, v₁ = −v₀, x₁ = x₀ + v₁Δt. It keeps E′ =
+        // ½v² + g·y − ½gΔt·v_y exactly (PHYSICS.md), never lets the ball through (it
+        // moves away from the wall from inside), and needs no sub-step time of impact.
+        const double wall = x1[k] > 0 ? limit : -limit;
+        v1[k] = -v0[k];
+        x1[k] = x0[k] + v1[k] * dt;
+        // A ball creeping along the floor (|v_y| < gΔt) may still cross, and one moving
+        // more than the box per step would cross the opposite wall: hold it inside.
+        x1[k] = std::clamp(x1[k], -limit, limit);
+        Vec3 normal(0.0);
+        normal[k] = wall > 0 ? -1.0 : 1.0;
+        ball.angularVelocity = glm::cross(normal, v1) / ball.radius;  // rolling on the wall
+        if (ball.kind == BallKind::Fireball) emitSparks(x1 - normal * ball.radius, normal, 6);
+    }
+    ball.velocity = v1;
+    ball.position = x1;
+}
+
+void World::collideBallLamp(Ball& ball) {
+    const Vec3 c = scene_.lamp.center;
+    const double reach = scene_.lamp.radius + ball.radius;
+    const Vec3 d = ball.position - c;
+    const double dist = glm::length(d);
+    if (dist >= reach || ball.position.y >= 1.0 || dist < 1e-12) return;
+    const Vec3 n = d / dist;
+    ball.position = c + n * reach;
+    ball.position.y = std::min(ball.position.y, 1.0 - ball.radius);
+    const double vn = glm::dot(ball.velocity, n);
+    if (vn < 0) ball.velocity -= 2.0 * vn * n;
+    if (ball.kind == BallKind::Fireball) emitSparks(c + n * scene_.lamp.radius, n, 6);
+}
+
+void World::collideBallTumblers(int bi) {
+    for (int i = 0; i < int(tumblers_.size()); ++i) {
+        Ball& ball = balls_[size_t(bi)];
+        // A fast ball (moved more than its radius this sub-step) could jump over a
+        // tumbler: conservative advancement along its path finds the first touch.
+        const Vec3 from = ballsBefore_[size_t(bi)], path = ball.position - from;
+        const double len = glm::length(path);
+        if (len > ball.radius) {
+            const Tumbler& t = tumblers_[size_t(i)];
+            // Bounding sphere about O (every point of the body is within y_t + t of it).
+            const double s = std::clamp(glm::dot(t.position - from, path) / (len * len), 0.0, 1.0);
+            if (glm::length(from + s * path - t.position) < shape_.top() + ball.radius) {
+                double along = 0.0;  // metres along the path
+                for (int iter = 0; iter < 64 && along < len; ++iter) {
+                    const double d = tumblerSdf(i, from + path * (along / len)) - ball.radius;
+                    if (d < 1e-4) {
+                        // Touching: stop a hair inside, so the contact below resolves it.
+                        ball.position = from + path * (std::min(len, along + 2e-4) / len);
+                        break;
+                    }
+                    along += d;
+                }
+            }
+        }
+        resolveBallTumblerContact(bi, i);
+    }
+}
+
+bool World::resolveBallTumblerContact(int bi, int i) {
+    Ball& ball = balls_[size_t(bi)];
+    const Tumbler& t = tumblers_[size_t(i)];
+    if (glm::length(ball.position - t.position) > shape_.top() + shape_.b() + ball.radius) return false;
+    const double d = tumblerSdf(i, ball.position);
+    if (d >= ball.radius) return false;
+    const Vec3 n = tumblerNormal(i, ball.position);
+    const Vec3 h = ball.position - d * n;  // the contact point on the surface
+    ball.position += n * (ball.radius - d);
+    const double vn = glm::dot(ball.velocity - pointVelocity(i, h), n);
+    if (vn >= 0.0) return true;
+    // Elastic two-body impulse: momentum and energy of ball + tumbler conserved.
+    const Vec3 r = h - centreOfMass(i);
+    const double k = 1.0 / ball.mass() + 1.0 / tumblerMass() +
+                     glm::dot(n, glm::cross(inverseInertiaWorld(i) * glm::cross(r, n), r));
+    const double jn = -2.0 * vn / k;
+    ball.velocity += (jn / ball.mass()) * n;
+    applyImpulse(i, h, -jn * n);
+    wake(i);
+    if (ball.kind == BallKind::Fireball) emitSparks(h, n, 10);
+    return true;
+}
+
+void World::collideBallPairs() {
+    const int n = int(balls_.size());
+    if (n < 2) return;
+    // Uniform grid over the box, cell ≥ the largest diameter: a ball can only touch
+    // balls in its own and the 26 neighbouring cells. Counting sort keeps it O(n) and
+    // deterministic (pairs are visited in ball index order).
+    double maxR = 0;
+    for (auto& b : balls_) maxR = std::max(maxR, b.radius);
+    const int dim = std::clamp(int(2.0 / (2.0 * maxR)), 1, 64);
+    const double inv = dim / 2.0;
+    auto cellOf = [&](const Vec3& p, int axis) { return std::clamp(int((p[axis] + 1.0) * inv), 0, dim - 1); };
+    gridCells_.resize(size_t(n));
+    gridStart_.assign(size_t(dim) * dim * dim + 1, 0);
+    gridOrder_.resize(size_t(n));
+    for (int i = 0; i < n; ++i) {
+        const Vec3& p = balls_[size_t(i)].position;
+        gridCells_[size_t(i)] = (cellOf(p, 0) * dim + cellOf(p, 1)) * dim + cellOf(p, 2);
+        ++gridStart_[size_t(gridCells_[size_t(i)]) + 1];
+    }
+    for (size_t c = 1; c < gridStart_.size(); ++c) gridStart_[c] += gridStart_[c - 1];
+    gridCursor_.assign(gridStart_.begin(), gridStart_.end() - 1);
+    for (int i = 0; i < n; ++i) gridOrder_[size_t(gridCursor_[size_t(gridCells_[size_t(i)])]++)] = i;
+    // Each ball against later balls in its own cell, and against every ball in the 13
+    // "forward" neighbour cells (the other 13 see this cell as their forward one).
+    for (int i = 0; i < n; ++i) {
+        const int c = gridCells_[size_t(i)];
+        const int cx = c / (dim * dim), cy = (c / dim) % dim, cz = c % dim;
+        for (int k = gridStart_[size_t(c)]; k < gridStart_[size_t(c) + 1]; ++k) {
+            const int j = gridOrder_[size_t(k)];
+            if (j > i) resolveBallBallContact(i, j);
+        }
+        for (int dx = 0; dx <= 1; ++dx)
+            for (int dy = dx ? -1 : 0; dy <= 1; ++dy)
+                for (int dz = (dx || dy) ? -1 : 1; dz <= 1; ++dz) {
+                    const int x = cx + dx, y = cy + dy, z = cz + dz;
+                    if (x >= dim || y < 0 || y >= dim || z < 0 || z >= dim) continue;
+                    const int cell = (x * dim + y) * dim + z;
+                    for (int k = gridStart_[size_t(cell)]; k < gridStart_[size_t(cell) + 1]; ++k)
+                        resolveBallBallContact(i, gridOrder_[size_t(k)]);
+                }
+    }
+}
+
+bool World::resolveBallBallContact(int ai, int bi) {
+    Ball& a = balls_[size_t(ai)];
+    Ball& b = balls_[size_t(bi)];
+    Vec3 d = b.position - a.position;
+    const double reach = a.radius + b.radius;
+    const double dist2 = glm::dot(d, d);
+    if (dist2 >= reach * reach) return false;
+    const double dist = std::sqrt(dist2);
+    // Coincident centres: no direction; separate along x (deterministic by index).
+    const Vec3 n = dist > 1e-12 ? d / dist : Vec3(ai < bi ? 1.0 : -1.0, 0, 0);
+    const double ma = a.mass(), mb = b.mass();
+    // Separate in proportion to the other's mass (the centre of mass stays put).
+    const double pen = reach - dist;
+    a.position -= n * (pen * mb / (ma + mb));
+    b.position += n * (pen * ma / (ma + mb));
+    const double vn = glm::dot(b.velocity - a.velocity, n);
+    if (vn < 0) {
+        const double j = -2.0 * vn / (1.0 / ma + 1.0 / mb);
+        a.velocity -= (j / ma) * n;
+        b.velocity += (j / mb) * n;
+    }
+    const bool aFire = a.kind == BallKind::Fireball, bFire = b.kind == BallKind::Fireball;
+    const Vec3 at = a.position + n * a.radius;
+    if (aFire && b.kind == BallKind::Marble) ignite(bi, at);
+    if (bFire && a.kind == BallKind::Marble) ignite(ai, at);
+    if ((aFire || bFire) && vn < 0) emitSparks(at, n, 8);
+    return true;
+}
+}  // namespace kiln::sim
