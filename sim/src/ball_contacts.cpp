@@ -6,9 +6,41 @@ namespace kiln::sim {
 
 using namespace detail;
 
+namespace {
+
+// The lamp dome as a time-symmetric bounce. Semi-implicit Euler keeps
+// E′ = ½|v|² + g·y − ½gΔt·v_y; writing u = v − ½gΔt·ŷ (the mid-step velocity),
+// E′ = ½|u|² + g·y + const. If the step would end inside the dome, the start-of-step
+// velocity is replaced by v₀′ = R_n(u₀) + ½gΔt·ŷ (u reflected about the dome normal at
+// the start point): |u| and y are unchanged, so E′ is exactly kept, and the step then
+// moves away from the dome. Returns true if it bounced.
+bool bounceOffLamp(const Scene::Lamp& lamp, double e, double gy, double dt, const Vec3& x0, Vec3& v0, double radius) {
+    const Vec3 c = lamp.center;
+    const double reach = lamp.radius + radius;
+    const Vec3 x1 = x0 + (v0 + Vec3(0, gy * dt, 0)) * dt;
+    if (glm::dot(x1 - c, x1 - c) >= reach * reach) return false;
+    const Vec3 d = x0 - c;
+    const double dist = glm::length(d);
+    if (dist < reach || dist < 1e-12) return false;  // started inside: collideBallLamp pushes it out
+    const Vec3 n = d / dist;
+    const Vec3 u = v0 + Vec3(0, 0.5 * gy * dt, 0);  // gy = −g: u = v − ½gΔt·ŷ
+    const double un = glm::dot(u, n);
+    if (un >= 0.0) return false;  // already leaving: a grazing step, leave it
+    v0 = (u - (1.0 + e) * un * n) - Vec3(0, 0.5 * gy * dt, 0);
+    return true;
+}
+
+}  // namespace
+
 void World::stepBall(Ball& ball, double dt) {
     const double gy = ball.kind == BallKind::Fireball ? 0.0 : -scene_.physics.gravity;
-    const Vec3 v0 = ball.velocity, x0 = ball.position;
+    const auto& rest = scene_.physics.restitution;
+    Vec3 v0 = ball.velocity;
+    const Vec3 x0 = ball.position;
+    if (bounceOffLamp(scene_.lamp, rest.ballLamp, gy, dt, x0, v0, ball.radius) && ball.kind == BallKind::Fireball) {
+        const Vec3 n = glm::normalize(x0 - scene_.lamp.center);
+        emitSparks(scene_.lamp.center + n * scene_.lamp.radius, n, 6);
+    }
     Vec3 v1 = v0;
     v1.y += gy * dt;
     Vec3 x1 = x0 + v1 * dt;
@@ -16,11 +48,11 @@ void World::stepBall(Ball& ball, double dt) {
     for (int k = 0; k < 3; ++k) {
         if (std::abs(x1[k]) <= limit) continue;
         // Time-symmetric bounce: a step that would cross the wall becomes the time
-        // reverse of the step that came in, v₁ = −v₀, x₁ = x₀ + v₁Δt. It keeps E′ =
-        // ½v² + g·y − ½gΔt·v_y exactly (PHYSICS.md), never lets the ball through (it
-        // moves away from the wall from inside), and needs no sub-step time of impact.
+        // reverse of the step that came in, v₁ = −e·v₀, x₁ = x₀ + v₁Δt. With e = 1 it
+        // keeps E′ = ½v² + g·y − ½gΔt·v_y exactly (PHYSICS.md), never lets the ball
+        // through (it moves away from the wall from inside), and needs no time of impact.
         const double wall = x1[k] > 0 ? limit : -limit;
-        v1[k] = -v0[k];
+        v1[k] = -rest.ballBox * v0[k];
         x1[k] = x0[k] + v1[k] * dt;
         // A ball creeping along the floor (|v_y| < gΔt) may still cross, and one moving
         // more than the box per step would cross the opposite wall: hold it inside.
@@ -35,17 +67,18 @@ void World::stepBall(Ball& ball, double dt) {
 }
 
 void World::collideBallLamp(Ball& ball) {
+    // Only for a ball that is inside the dome already (pushed there by another contact
+    // or spawned there): push it out along the normal and reflect what moves inwards.
     const Vec3 c = scene_.lamp.center;
     const double reach = scene_.lamp.radius + ball.radius;
     const Vec3 d = ball.position - c;
     const double dist = glm::length(d);
-    if (dist >= reach || ball.position.y >= 1.0 || dist < 1e-12) return;
+    if (dist >= reach || dist < 1e-12) return;
     const Vec3 n = d / dist;
     ball.position = c + n * reach;
     ball.position.y = std::min(ball.position.y, 1.0 - ball.radius);
     const double vn = glm::dot(ball.velocity, n);
-    if (vn < 0) ball.velocity -= 2.0 * vn * n;
-    if (ball.kind == BallKind::Fireball) emitSparks(c + n * scene_.lamp.radius, n, 6);
+    if (vn < 0) ball.velocity -= (1.0 + scene_.physics.restitution.ballLamp) * vn * n;
 }
 
 void World::collideBallTumblers(int bi) {
@@ -87,16 +120,42 @@ bool World::resolveBallTumblerContact(int bi, int i) {
     ball.position += n * (ball.radius - d);
     const double vn = glm::dot(ball.velocity - pointVelocity(i, h), n);
     if (vn >= 0.0) return true;
-    // Elastic two-body impulse: momentum and energy of ball + tumbler conserved.
-    const Vec3 r = h - centreOfMass(i);
-    const double k = 1.0 / ball.mass() + 1.0 / tumblerMass() +
-                     glm::dot(n, glm::cross(inverseInertiaWorld(i) * glm::cross(r, n), r));
-    const double jn = -2.0 * vn / k;
+    // The tumbler answers with its rolling-constrained effective mass (the floor holds
+    // its contact point), so the relative normal velocity becomes exactly −e·vn, and
+    // with e = 1 the kinetic energy of ball + tumbler is kept.
+    const double k = 1.0 / ball.mass() + rollingInverseMass(i, h, n);
+    const double jn = -(1.0 + scene_.physics.restitution.ballTumbler) * vn / k;
     ball.velocity += (jn / ball.mass()) * n;
-    applyImpulse(i, h, -jn * n);
+    applyRollingImpulse(i, h, -jn * n);
     wake(i);
     if (ball.kind == BallKind::Fireball) emitSparks(h, n, 10);
     return true;
+}
+
+void World::separateBallsFromTumblers() {
+    // After the wall clamp: a ball still overlapping a tumbler is pinned between it and a
+    // wall (or another ball pushed it back). Move it out along the normal as far as the
+    // walls allow, and move the tumbler horizontally away by what is left; the tumbler's
+    // walls then run again. Velocities were settled by the contact impulses already.
+    for (int bi = 0; bi < int(balls_.size()); ++bi) {
+        Ball& ball = balls_[size_t(bi)];
+        const double limit = 1.0 - ball.radius;
+        for (int i = 0; i < int(tumblers_.size()); ++i) {
+            const double d = tumblerSdf(i, ball.position);
+            if (d >= ball.radius - 1e-9) continue;
+            const Vec3 n = tumblerNormal(i, ball.position);
+            const Vec3 before = ball.position;
+            ball.position = glm::clamp(ball.position + n * (ball.radius - d), Vec3(-limit), Vec3(limit));
+            const double left = ball.radius - tumblerSdf(i, ball.position);
+            if (left <= 0.0) continue;
+            Vec3 nh(n.x, 0.0, n.z);
+            const double l = glm::length(nh);
+            nh = l > 1e-9 ? nh / l : glm::normalize(Vec3(ball.position.x - before.x + 1e-12, 0.0, 0.0));
+            tumblers_[size_t(i)].position -= nh * (left / std::max(l, 1.0 / 3.0));
+            collideTumblerWalls(i);
+            wake(i);
+        }
+    }
 }
 
 void World::collideBallPairs() {
@@ -159,7 +218,7 @@ bool World::resolveBallBallContact(int ai, int bi) {
     b.position += n * (pen * ma / (ma + mb));
     const double vn = glm::dot(b.velocity - a.velocity, n);
     if (vn < 0) {
-        const double j = -2.0 * vn / (1.0 / ma + 1.0 / mb);
+        const double j = -(1.0 + scene_.physics.restitution.ballBall) * vn / (1.0 / ma + 1.0 / mb);
         a.velocity -= (j / ma) * n;
         b.velocity += (j / mb) * n;
     }

@@ -13,7 +13,6 @@ namespace kiln::sim::detail {
 inline constexpr double kPi = 3.14159265358979323846;
 inline constexpr double kFireRate = 400.0;  // particles per second per fireball (SPEC §5)
 inline constexpr double kFireLife = 0.45;
-inline constexpr double kTumblerRestitution = 0.5;
 
 // [r]× as a column-major glm matrix: skew(r) * v == cross(r, v).
 inline Mat3 skew(const Vec3& r) { return Mat3(0, r.z, -r.y, -r.z, 0, r.x, r.y, -r.x, 0); }

@@ -156,6 +156,17 @@ bool balls(const Json& root, const std::string& key, std::vector<Scene::BallSpec
     return true;
 }
 
+bool restitution(const Json& physics, Scene::Physics::Restitution& e, SceneError& error) {
+    const Json* o = nullptr;
+    if (!object(physics, "restitution", "physics.restitution", error, o)) return false;
+    if (!o) return true;
+    Reader r{*o, "physics.restitution", error, {}};
+    return r.number("ball_box", e.ballBox, 0, 1) && r.number("ball_lamp", e.ballLamp, 0, 1) &&
+           r.number("ball_ball", e.ballBall, 0, 1) && r.number("ball_tumbler", e.ballTumbler, 0, 1) &&
+           r.number("tumbler_tumbler", e.tumblerTumbler, 0, 1) && r.number("tumbler_floor", e.tumblerFloor, 0, 1) &&
+           r.finish();
+}
+
 }  // namespace
 
 bool parseScene(const std::string& text, Scene& out, SceneError& error) {
@@ -208,7 +219,7 @@ bool parseScene(const std::string& text, Scene& out, SceneError& error) {
     }
     if (!object(root, "physics", "physics", error, o)) return false;
     if (o) {
-        Reader r{*o, "physics", error, {}};
+        Reader r{*o, "physics", error, {"restitution"}};
         int mode = int(s.physics.tumblerMode), contact = int(s.physics.tumblerContact);
         double seed = double(s.physics.seed);
         if (!r.number("dt", s.physics.dt, 1e-5, 0.1) || !r.integer("substeps", s.physics.substeps, 1, 64) ||
@@ -218,6 +229,7 @@ bool parseScene(const std::string& text, Scene& out, SceneError& error) {
             !r.choice("tumbler_contact", {"four_spheres", "exact"}, contact) ||
             !r.number("ballast_h", s.physics.ballastH, -0.19, 0.19) || !r.number("seed", seed, 0, 4294967295.0) || !r.finish())
             return false;
+        if (!restitution(*o, s.physics.restitution, error)) return false;
         s.physics.tumblerMode = TumblerMode(mode);
         s.physics.tumblerContact = TumblerContact(contact);
         s.physics.seed = uint64_t(seed);

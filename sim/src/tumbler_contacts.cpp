@@ -38,35 +38,40 @@ double fourSphereContact(const World& w, int a, int b, const RoundCone& shape, V
 }  // namespace
 
 void World::collideTumblerWalls(int i) {
+    // Both spheres against the four side walls: a horizontal push of O (the tumbler keeps
+    // its orientation, so nothing else moves back in), then, if the touching point moves
+    // into the wall, a rolling-constrained impulse that leaves it with −wall_decay times
+    // its normal velocity.
     Tumbler& t = tumblers_[size_t(i)];
-    const double decay = scene_.physics.wallDecay;
-    const Vec3 centres[2] = {t.position, t.upperCentre(shape_)};
     const double radii[2] = {shape_.b(), shape_.t()};
     for (int axis : {0, 2}) {
+        const Vec3 centres[2] = {t.position, t.upperCentre(shape_)};
         double push = 0.0;
+        int touching = -1;
         for (int k = 0; k < 2; ++k) {
             const double limit = 1.0 - radii[k];
-            if (centres[k][axis] > limit) push = std::min(push, limit - centres[k][axis]);
-            if (centres[k][axis] < -limit) push = std::max(push, -limit - centres[k][axis]);
+            if (centres[k][axis] > limit && limit - centres[k][axis] < push) push = limit - centres[k][axis], touching = k;
+            if (centres[k][axis] < -limit && -limit - centres[k][axis] > push) push = -limit - centres[k][axis], touching = k;
         }
-        if (push == 0.0) continue;
+        if (touching < 0) continue;
         t.position[axis] += push;
-        const double sign = push < 0 ? 1.0 : -1.0;  // +1: the wall at +1
-        // Reverse the wall-normal velocity (and the rolling spin that carries it).
-        if (t.velocity[axis] * sign > 0) {
-            t.velocity[axis] *= -decay;
-            if (axis == 0) t.angularVelocity.z *= -decay;
-            else t.angularVelocity.x *= -decay;
-        }
+        Vec3 n(0.0);  // into the box
+        n[axis] = push < 0 ? -1.0 : 1.0;
+        const Vec3 at = (touching == 0 ? t.position : t.upperCentre(shape_)) - n * radii[touching];
+        const double vn = glm::dot(pointVelocity(i, at), n);
+        const double k = rollingInverseMass(i, at, n);
+        if (vn < 0.0 && k > 1e-12) applyRollingImpulse(i, at, (-(1.0 + scene_.physics.wallDecay) * vn / k) * n);
         wake(i);
     }
 }
 
 void World::collideTumblerFloor(int i) {
-    // Only the upper sphere can reach the floor (the toy fell over): it lies there when
-    // axis·y = (t − b)/y_t (≈ 110° for the default shape). Rotate it back exactly onto
-    // the floor about the horizontal axis of its tilt, stop it, and let gravity (or the
-    // seed's restoring impulse) right it from there.
+    // The toppled regime. The lower sphere touches the floor while the tilt θ is below
+    // 90° + α (where the side lies on the floor, axis·ŷ = (t − b)/y_t); beyond it the
+    // upper sphere would go through. Roll back to that pose — a rotation about the
+    // horizontal tilt axis through O with O shifted by the matching rolling distance, so
+    // no slip creeps in — then give the upper sphere's lowest point a rolling-constrained
+    // impulse that leaves it with −e_floor times its downward velocity.
     Tumbler& t = tumblers_[size_t(i)];
     const double cosLying = (shape_.t() - shape_.b()) / shape_.upperCentre();
     const Vec3 axis = t.axis();
@@ -77,8 +82,10 @@ void World::collideTumblerFloor(int i) {
     else tiltAxis /= len;
     const double angle = std::acos(std::clamp(axis.y, -1.0, 1.0)) - std::acos(cosLying);
     t.orientation = glm::normalize(glm::angleAxis(angle, tiltAxis) * t.orientation);
-    t.velocity = Vec3(0.0);
-    t.angularVelocity = Vec3(0.0);
+    t.position += shape_.b() * angle * glm::cross(tiltAxis, Vec3(0, 1, 0));
+    const Vec3 at = t.upperCentre(shape_) - Vec3(0, shape_.t(), 0), up(0, 1, 0);
+    const double vn = pointVelocity(i, at).y, k = rollingInverseMass(i, at, up);
+    if (vn < 0.0 && k > 1e-12) applyRollingImpulse(i, at, (-(1.0 + scene_.physics.restitution.tumblerFloor) * vn / k) * up);
 }
 
 double World::resolveTumblerPair(int a, int b) {
@@ -112,25 +119,22 @@ double World::resolveTumblerPair(int a, int b) {
         n = Vec3(ta.position.x <= tb.position.x ? 1.0 : -1.0, 0, 0);
         if (ta.position.x == tb.position.x) n = Vec3(a < b ? 1.0 : -1.0, 0, 0);
     }
-    // Separate on the floor plane, half each (both stay on the floor).
+    // Separate on the floor plane, half each (both stay on the floor); a contact normal
+    // that is far from horizontal needs a longer horizontal push (up to 3×).
     Vec3 nh(n.x, 0.0, n.z);
     const double nhl = glm::length(nh);
     nh = nhl > 1e-9 ? nh / nhl : Vec3(1, 0, 0);
-    const double depth = std::min(-separation, 2.0 * shape_.b());
+    const double depth = std::min(-separation / std::max(nhl, 1.0 / 3.0), 2.0 * shape_.b());
     ta.position -= nh * (0.5 * depth);
     tb.position += nh * (0.5 * depth);
-    // Normal impulse from the relative velocity at the contact: the scalar form of
-    // j = K⁻¹Δv along n (n·K·n > 0 always, so it never divides by zero).
-    const Vec3 vRel = pointVelocity(b, h) - pointVelocity(a, h);
-    const double vn = glm::dot(vRel, n);
-    if (vn < 0.0) {
-        auto kOf = [&](int i) {
-            const Vec3 r = h - centreOfMass(i);
-            return 1.0 / tumblerMass() + glm::dot(n, glm::cross(inverseInertiaWorld(i) * glm::cross(r, n), r));
-        };
-        const double jn = -(1.0 + kTumblerRestitution) * vn / (kOf(a) + kOf(b));
-        applyImpulse(a, h, -jn * n);
-        applyImpulse(b, h, jn * n);
+    // Normal impulse with both tumblers' rolling-constrained responses: the relative
+    // normal velocity at the contact becomes −e times what it was.
+    const double vn = glm::dot(pointVelocity(b, h) - pointVelocity(a, h), n);
+    const double k = rollingInverseMass(a, h, n) + rollingInverseMass(b, h, n);
+    if (vn < 0.0 && k > 1e-12) {
+        const double jn = -(1.0 + scene_.physics.restitution.tumblerTumbler) * vn / k;
+        applyRollingImpulse(a, h, -jn * n);
+        applyRollingImpulse(b, h, jn * n);
     }
     wake(a);
     wake(b);

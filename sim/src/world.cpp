@@ -60,6 +60,50 @@ Vec3 World::pointVelocity(int i, const Vec3& p) const {
     return t.velocity + glm::cross(t.angularVelocity, p - t.position);
 }
 
+Vec3 World::floorContact(int i) const {
+    const Tumbler& t = tumblers_[size_t(i)];
+    return Vec3(t.position.x, t.position.y - shape_.b(), t.position.z);
+}
+
+Mat3 World::rollingInertia(int i) const {
+    const Mat3 R = tumblers_[size_t(i)].rotation();
+    const Mat3 IG = R * Mat3(inertiaCom_.x, 0, 0, 0, inertiaCom_.y, 0, 0, 0, inertiaCom_.z) * glm::transpose(R);
+    const Vec3 r = centreOfMass(i) - floorContact(i);
+    return IG + tumblerMass() * (glm::dot(r, r) * Mat3(1.0) - glm::outerProduct(r, r));
+}
+
+double World::rollingInverseMass(int i, const Vec3& p, const Vec3& n) const {
+    const Vec3 rn = glm::cross(p - floorContact(i), n);
+    return glm::dot(rn, glm::inverse(rollingInertia(i)) * rn);
+}
+
+void World::applyRollingImpulse(int i, const Vec3& p, const Vec3& j) {
+    // Angular momentum about the contact point changes by (p − P) × j; the floor's own
+    // impulse acts at P and has no moment there. The body then turns about P.
+    Tumbler& t = tumblers_[size_t(i)];
+    t.angularVelocity += glm::inverse(rollingInertia(i)) * glm::cross(p - floorContact(i), j);
+    t.velocity = shape_.b() * Vec3(-t.angularVelocity.z, 0.0, t.angularVelocity.x);
+}
+
+double World::tumblerEnergy(int i) const {
+    const Vec3& w = tumblers_[size_t(i)].angularVelocity;
+    return 0.5 * glm::dot(w, rollingInertia(i) * w) + tumblerMass() * scene_.physics.gravity * centreOfMass(i).y;
+}
+
+double World::tumblerJellett(int i) const {
+    const Tumbler& t = tumblers_[size_t(i)];
+    const Mat3 R = t.rotation();
+    const Mat3 IG = R * Mat3(inertiaCom_.x, 0, 0, 0, inertiaCom_.y, 0, 0, 0, inertiaCom_.z) * glm::transpose(R);
+    return glm::dot(IG * t.angularVelocity, centreOfMass(i) - floorContact(i));
+}
+
+double World::totalEnergy() const {
+    double e = 0.0;
+    for (int i = 0; i < int(tumblers_.size()); ++i) e += tumblerEnergy(i);
+    for (int i = 0; i < int(balls_.size()); ++i) e += balls_[size_t(i)].mass() * ballEnergy(i);
+    return e;
+}
+
 void World::applyImpulse(int i, const Vec3& p, const Vec3& j) {
     Tumbler& t = tumblers_[size_t(i)];
     const Vec3 g = centreOfMass(i);
@@ -98,24 +142,27 @@ void World::step() {
 }
 
 void World::substep(double dt) {
+    // Order (each correction runs after the ones it could undo): integrate; a toppled
+    // tumbler rolls back onto its lower sphere (rotation + rolling shift); tumbler pairs
+    // separate (horizontal); the walls push last, so tumblers always end inside.
     for (int i = 0; i < int(tumblers_.size()); ++i) stepTumbler(i, dt);
+    for (int i = 0; i < int(tumblers_.size()); ++i) collideTumblerFloor(i);
     for (int a = 0; a < int(tumblers_.size()); ++a)
         for (int b = a + 1; b < int(tumblers_.size()); ++b) resolveTumblerPair(a, b);
-    for (int i = 0; i < int(tumblers_.size()); ++i) {
-        collideTumblerWalls(i);
-        collideTumblerFloor(i);
-    }
+    for (int i = 0; i < int(tumblers_.size()); ++i) collideTumblerWalls(i);
     ballsBefore_.resize(balls_.size());
     for (size_t i = 0; i < balls_.size(); ++i) ballsBefore_[i] = balls_[i].position;
     for (auto& ball : balls_) stepBall(ball, dt);
     if (!balls_.empty()) bodiesMoved_ = true;
     for (int i = 0; i < int(balls_.size()); ++i) {
-        collideBallLamp(balls_[size_t(i)]);
+        collideBallLamp(balls_[size_t(i)]);  // only a ball that started inside the dome
         collideBallTumblers(i);
     }
     collideBallPairs();
-    // Contact pushes may nudge a ball past a wall: containment is exact per sphere.
+    // Contact pushes may nudge a ball past a wall or back into a tumbler: walls first
+    // (exact per sphere), then tumblers give way where a ball has nowhere to go.
     for (auto& b : balls_) b.position = glm::clamp(b.position, Vec3(b.radius - 1.0), Vec3(1.0 - b.radius));
+    separateBallsFromTumblers();
     // Burning marbles turn to ash.
     for (size_t i = 0; i < balls_.size();) {
         Ball& b = balls_[i];

@@ -175,8 +175,29 @@ public:
     // Resolves tumblers a and b with the scene's method; returns the separation it saw
     // (negative: overlap) or +inf when they are too far apart to test.
     double resolveTumblerPair(int a, int b);
-    // Applies impulse j at world point p to tumbler i (no constraints).
+    // Applies impulse j at world point p to tumbler i as a free body (no floor; the
+    // seed's model). Contacts use applyRollingImpulse.
     void applyImpulse(int i, const Vec3& p, const Vec3& j);
+    // Applies impulse j at world point p to tumbler i while it rolls on the floor: the
+    // floor answers with whatever impulse at the contact point keeps it rolling without
+    // slipping, so Δω = A⁻¹·((p − P) × j) with A = rollingInertia(i), and the velocity
+    // stays consistent with the constraint (nothing is discarded at the next sub-step).
+    void applyRollingImpulse(int i, const Vec3& p, const Vec3& j);
+    // The floor contact P = O − b·ŷ (the lowest point of the lower sphere).
+    Vec3 floorContact(int i) const;
+    // Inertia about the floor contact, world frame: A = I_G + m(|r|²𝟙 − r·rᵀ), r = G − P.
+    // The rolling body's kinetic energy is ½ωᵀAω and its angular momentum about P is Aω.
+    Mat3 rollingInertia(int i) const;
+    // Inverse effective mass of tumbler i at world point p along unit n given that it
+    // rolls: n·Δv_p per unit impulse along n, = (ρ×n)ᵀA⁻¹(ρ×n), ρ = p − P.
+    double rollingInverseMass(int i, const Vec3& p, const Vec3& n) const;
+    // Mechanical energy of tumbler i (rolling kinetic ½ωᵀAω + m·g·G_y, floor at y = −1
+    // is not subtracted) and Jellett's quantity L_G·(G − P) = L_P·(G − P), conserved by
+    // frictionless rolling of a body of revolution on a sphere base (PHYSICS.md).
+    double tumblerEnergy(int i) const;
+    double tumblerJellett(int i) const;
+    // Σ tumblerEnergy + Σ ball mass × ballEnergy (the balls' modified energy E′).
+    double totalEnergy() const;
     // Velocity of the material point of tumbler i at world point p.
     Vec3 pointVelocity(int i, const Vec3& p) const;
     // World-space inverse inertia of tumbler i about its centre of mass.
@@ -202,8 +223,13 @@ public:
 private:
     void substep(double dt);
     void stepTumbler(int i, double dt);
+    void stepTumblerSeed(int i, double dt);
+    void stepTumblerRolling(int i, double dt);
+    void applyFriction(Tumbler& t, double dt) const;
+    void updateSleep(Tumbler& t, double dt);
     void collideTumblerWalls(int i);
     void collideTumblerFloor(int i);
+    void separateBallsFromTumblers();
     void stepBall(Ball& ball, double dt);
     void collideBallTumblers(int ball);
     void collideBallPairs();
