@@ -32,7 +32,39 @@ bool bounceOffLamp(const Scene::Lamp& lamp, double e, double gy, double dt, cons
 
 }  // namespace
 
-void World::stepBall(Ball& ball, double dt) {
+void World::bounceOffTumblers(int bi, double gy, double dt, Vec3& v0) {
+    // The tumblers as time-symmetric bounces too: if the step from x₀ would end inside a
+    // tumbler (already moved this sub-step), the hit happens at the start instead, on the
+    // mid-step velocity u = v₀ + ½g_yΔt·ŷ, against the tumbler's rolling-constrained
+    // response at the point nearest x₀. The ball's E′ = ½|u|² + g·y + const and the
+    // tumbler's energy then change by exactly the kinetic energy the impulse moves
+    // between them (none lost for e = 1), and no position is pushed. A ball that starts
+    // inside (pushed there by another contact) is left to resolveBallTumblerContact.
+    Ball& ball = balls_[size_t(bi)];
+    const Vec3 x0 = ball.position;
+    for (int i = 0; i < int(tumblers_.size()); ++i) {
+        if (glm::length(x0 - tumblers_[size_t(i)].position) > shape_.top() + shape_.b() + ball.radius + glm::length(v0) * dt + 0.5 * std::abs(gy) * dt * dt)
+            continue;
+        const Vec3 x1 = x0 + (v0 + Vec3(0, gy * dt, 0)) * dt;
+        if (tumblerSdf(i, x1) >= ball.radius) continue;
+        const double d0 = tumblerSdf(i, x0);
+        if (d0 < ball.radius) continue;
+        const Vec3 n = tumblerNormal(i, x0), h = x0 - d0 * n;
+        Vec3 u = v0 + Vec3(0, 0.5 * gy * dt, 0);
+        const double vn = glm::dot(u - pointVelocity(i, h), n);
+        if (vn >= 0.0) continue;  // separating at the start: a graze, the push handles it
+        const double k = 1.0 / ball.mass() + rollingInverseMass(i, h, n);
+        const double jn = -(1.0 + scene_.physics.restitution.ballTumbler) * vn / k;
+        u += (jn / ball.mass()) * n;
+        applyRollingImpulse(i, h, -jn * n);
+        wake(i);
+        v0 = u - Vec3(0, 0.5 * gy * dt, 0);
+        if (ball.kind == BallKind::Fireball) emitSparks(h, n, 10);
+    }
+}
+
+void World::stepBall(int bi, double dt) {
+    Ball& ball = balls_[size_t(bi)];
     const double gy = ball.kind == BallKind::Fireball ? 0.0 : -scene_.physics.gravity;
     const auto& rest = scene_.physics.restitution;
     Vec3 v0 = ball.velocity;
@@ -41,6 +73,7 @@ void World::stepBall(Ball& ball, double dt) {
         const Vec3 n = glm::normalize(x0 - scene_.lamp.center);
         emitSparks(scene_.lamp.center + n * scene_.lamp.radius, n, 6);
     }
+    bounceOffTumblers(bi, gy, dt, v0);
     Vec3 v1 = v0;
     v1.y += gy * dt;
     Vec3 x1 = x0 + v1 * dt;
@@ -109,6 +142,20 @@ void World::collideBallTumblers(int bi) {
     }
 }
 
+void World::moveBallKeepingEnergy(Ball& ball, const Vec3& to) {
+    // A position correction (a ball pushed out of a tumbler that moved into it) changes
+    // the ball's height and so its E′ = ½|u|² + g·y + const (u = v − ½gΔt·ŷ). Scaling u
+    // to pay for the height keeps E′; only a ball too slow to pay gains the rest.
+    const double g = ball.kind == BallKind::Fireball ? 0.0 : scene_.physics.gravity;
+    const double dt = scene_.physics.dt / std::max(1, scene_.physics.substeps);
+    const Vec3 half(0, 0.5 * g * dt, 0);
+    const Vec3 u = ball.velocity - half;
+    const double u2 = glm::dot(u, u), paid = 2.0 * g * (to.y - ball.position.y);
+    ball.position = to;
+    if (paid == 0.0 || u2 <= 0.0) return;
+    ball.velocity = u * std::sqrt(std::max(0.0, 1.0 - paid / u2)) + half;
+}
+
 bool World::resolveBallTumblerContact(int bi, int i) {
     Ball& ball = balls_[size_t(bi)];
     const Tumbler& t = tumblers_[size_t(i)];
@@ -117,8 +164,12 @@ bool World::resolveBallTumblerContact(int bi, int i) {
     if (d >= ball.radius) return false;
     const Vec3 n = tumblerNormal(i, ball.position);
     const Vec3 h = ball.position - d * n;  // the contact point on the surface
-    ball.position += n * (ball.radius - d);
-    const double vn = glm::dot(ball.velocity - pointVelocity(i, h), n);
+    moveBallKeepingEnergy(ball, ball.position + n * (ball.radius - d));
+    // The impulse acts on the mid-step velocity u = v − ½gΔt·ŷ, the one the ball's E′
+    // counts (½|u|² + g·y), so an elastic hit moves energy without making or losing any.
+    const double g = ball.kind == BallKind::Fireball ? 0.0 : scene_.physics.gravity;
+    const Vec3 u = ball.velocity - Vec3(0, 0.5 * g * scene_.physics.dt / std::max(1, scene_.physics.substeps), 0);
+    const double vn = glm::dot(u - pointVelocity(i, h), n);
     if (vn >= 0.0) return true;
     // The tumbler answers with its rolling-constrained effective mass (the floor holds
     // its contact point), so the relative normal velocity becomes exactly −e·vn, and
@@ -132,7 +183,8 @@ bool World::resolveBallTumblerContact(int bi, int i) {
     return true;
 }
 
-void World::separateBallsFromTumblers() {
+bool World::separateBallsFromTumblers() {
+    bool movedTumbler = false;
     // After the wall clamp: a ball still overlapping a tumbler is pinned between it and a
     // wall (or another ball pushed it back). Move it out along the normal as far as the
     // walls allow, and move the tumbler horizontally away by what is left; the tumbler's
@@ -145,7 +197,7 @@ void World::separateBallsFromTumblers() {
             if (d >= ball.radius - 1e-9) continue;
             const Vec3 n = tumblerNormal(i, ball.position);
             const Vec3 before = ball.position;
-            ball.position = glm::clamp(ball.position + n * (ball.radius - d), Vec3(-limit), Vec3(limit));
+            moveBallKeepingEnergy(ball, glm::clamp(ball.position + n * (ball.radius - d), Vec3(-limit), Vec3(limit)));
             const double left = ball.radius - tumblerSdf(i, ball.position);
             if (left <= 0.0) continue;
             Vec3 nh(n.x, 0.0, n.z);
@@ -154,8 +206,10 @@ void World::separateBallsFromTumblers() {
             tumblers_[size_t(i)].position -= nh * (left / std::max(l, 1.0 / 3.0));
             collideTumblerWalls(i);
             wake(i);
+            movedTumbler = true;
         }
     }
+    return movedTumbler;
 }
 
 void World::collideBallPairs() {
@@ -212,11 +266,23 @@ bool World::resolveBallBallContact(int ai, int bi) {
     // Coincident centres: no direction; separate along x (deterministic by index).
     const Vec3 n = dist > 1e-12 ? d / dist : Vec3(ai < bi ? 1.0 : -1.0, 0, 0);
     const double ma = a.mass(), mb = b.mass();
-    // Separate in proportion to the other's mass (the centre of mass stays put).
+    // Separate in proportion to the other's mass (the centre of mass stays put, and with
+    // it the pair's potential energy). A fireball feels no gravity: against a marble the
+    // marble's push is paid from its own speed (moveBallKeepingEnergy).
     const double pen = reach - dist;
-    a.position -= n * (pen * mb / (ma + mb));
-    b.position += n * (pen * ma / (ma + mb));
-    const double vn = glm::dot(b.velocity - a.velocity, n);
+    const double ga = a.kind == BallKind::Fireball ? 0.0 : scene_.physics.gravity;
+    const double gb = b.kind == BallKind::Fireball ? 0.0 : scene_.physics.gravity;
+    if (ga == gb) {
+        a.position -= n * (pen * mb / (ma + mb));
+        b.position += n * (pen * ma / (ma + mb));
+    } else {
+        moveBallKeepingEnergy(a, a.position - n * (pen * mb / (ma + mb)));
+        moveBallKeepingEnergy(b, b.position + n * (pen * ma / (ma + mb)));
+    }
+    // The impulse from the mid-step velocities u = v − ½gΔt·ŷ (what E′ counts); for two
+    // balls under the same gravity that is the same relative velocity as v's.
+    const double halfDt = 0.5 * scene_.physics.dt / std::max(1, scene_.physics.substeps);
+    const double vn = glm::dot(b.velocity - a.velocity, n) + (ga - gb) * halfDt * n.y;
     if (vn < 0) {
         const double j = -(1.0 + scene_.physics.restitution.ballBall) * vn / (1.0 / ma + 1.0 / mb);
         a.velocity -= (j / ma) * n;

@@ -44,7 +44,7 @@ uint64_t World::stateHash() const {
         f.add(uint64_t(p.kind));
     }
     f.add(rng_.state()), f.add(rng_.stream());
-    f.add(time_), f.add(steps_);
+    f.add(time_), f.add(steps_), f.add(removedBallEnergy_);
     f.add(drag_.tumbler), f.add(uint64_t(drag_.mode)), f.add(drag_.planeY), f.add(drag_.offset);
     return f.h;
 }

@@ -223,6 +223,7 @@ bool parseScene(const std::string& text, Scene& out, SceneError& error) {
         int mode = int(s.physics.tumblerMode), contact = int(s.physics.tumblerContact);
         double seed = double(s.physics.seed);
         if (!r.number("dt", s.physics.dt, 1e-5, 0.1) || !r.integer("substeps", s.physics.substeps, 1, 64) ||
+            !r.integer("max_substeps", s.physics.maxSubsteps, 1, 4096) ||
             !r.number("gravity", s.physics.gravity, 0, 100) || !r.number("friction", s.physics.friction, 0, 10) ||
             !r.number("wall_decay", s.physics.wallDecay, 0, 1) ||
             !r.choice("tumbler_mode", {"seed", "accurate"}, mode) ||

@@ -83,6 +83,13 @@ void World::collideTumblerFloor(int i) {
     const double angle = std::acos(std::clamp(axis.y, -1.0, 1.0)) - std::acos(cosLying);
     t.orientation = glm::normalize(glm::angleAxis(angle, tiltAxis) * t.orientation);
     t.position += shape_.b() * angle * glm::cross(tiltAxis, Vec3(0, 1, 0));
+    landOnSide(i);
+}
+
+void World::landOnSide(int i) {
+    // The upper sphere's lowest point meets the floor: a rolling-constrained impulse there
+    // leaves it with −e_floor times its downward velocity.
+    Tumbler& t = tumblers_[size_t(i)];
     const Vec3 at = t.upperCentre(shape_) - Vec3(0, shape_.t(), 0), up(0, 1, 0);
     const double vn = pointVelocity(i, at).y, k = rollingInverseMass(i, at, up);
     if (vn < 0.0 && k > 1e-12) applyRollingImpulse(i, at, (-(1.0 + scene_.physics.restitution.tumblerFloor) * vn / k) * up);

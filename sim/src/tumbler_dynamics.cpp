@@ -78,12 +78,41 @@ void World::stepTumbler(int i, double dt) {
 }
 
 void World::stepTumblerRolling(int i, double dt) {
+    // A step that would tilt the tumbler past lying on its side (axis·ŷ below
+    // (t − b)/y_t, the upper sphere in the floor) is split at the moment it gets there
+    // (bisection on the step length, each trial a fresh RK4 from the step's start): the
+    // floor's impulse acts at that pose, then the rest of the step runs. So the landing
+    // neither loses nor gains energy beyond the restitution's, whatever the Δt.
     Tumbler& t = tumblers_[size_t(i)];
     const RollBody body{tumblerMass(), scene_.physics.gravity, shape_.b(), comLocal_, inertiaCom_};
-    const RollState next = rk4(body, {t.position, t.orientation, t.angularVelocity}, dt);
-    t.position = Vec3(next.o.x, -1.0 + shape_.b(), next.o.z);
-    t.orientation = next.q;
-    t.angularVelocity = next.w;
+    const double cosLying = (shape_.t() - shape_.b()) / shape_.upperCentre();
+    auto lying = [&](const RollState& st) { return (st.q * Vec3(0, 1, 0)).y < cosLying; };
+    RollState start{t.position, t.orientation, t.angularVelocity};
+    double left = dt;
+    for (int event = 0; event < 4 && left > 0.0; ++event) {
+        RollState next = rk4(body, start, left);
+        if (!lying(next) || lying(start)) {
+            start = next;
+            left = 0.0;
+            break;
+        }
+        double lo = 0.0, hi = left;  // lying(rk4(lo)) false, lying(rk4(hi)) true
+        for (int it = 0; it < 40; ++it) {
+            const double mid = 0.5 * (lo + hi);
+            (lying(rk4(body, start, mid)) ? hi : lo) = mid;
+        }
+        start = rk4(body, start, lo);
+        left -= lo;
+        t.position = Vec3(start.o.x, -1.0 + shape_.b(), start.o.z), t.orientation = start.q;
+        t.angularVelocity = start.w;
+        landOnSide(i);
+        start = {t.position, t.orientation, t.angularVelocity};
+        if (left < 1e-12 * dt) left = 0.0;
+    }
+    if (left > 0.0) start = rk4(body, start, left);  // resting on its side: collideTumblerFloor settles it
+    t.position = Vec3(start.o.x, -1.0 + shape_.b(), start.o.z);
+    t.orientation = start.q;
+    t.angularVelocity = start.w;
 }
 
 void World::stepTumblerSeed(int i, double dt) {

@@ -87,6 +87,7 @@ Scene rockingScene(double amplitude, double dt, int substeps) {
     s.physics.ballastH = 0.05;
     s.physics.dt = dt;
     s.physics.substeps = substeps;
+    s.physics.maxSubsteps = substeps;  // the fixed count asked for (no adaptive sub-steps)
     s.tumblers.push_back({{0.0, 0.0}, {0.0, amplitude}, {1, 0, 0}});
     return s;
 }

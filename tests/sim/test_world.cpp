@@ -29,7 +29,7 @@ Scene defaultScene() {
 }
 
 // stateHash() of scenes/cornell.json, seed 1, after 1500 frames (see the determinism test).
-constexpr uint64_t kCornellHash1500 = 0x52b629db38c36e7dull;
+constexpr uint64_t kCornellHash1500 = 0x184af23dde45fce0ull;
 
 double tiltAboutZ(const Tumbler& t) {
     const Vec3 a = t.axis();
@@ -53,21 +53,25 @@ TEST_CASE("a ball-tumbler hit honours its restitution with the rolling tumbler's
         World w(s);
         w.tumblers()[0].angularVelocity = Vec3(0.3, 0.5, -0.4);  // rolling, spinning, rocking
         w.tumblers()[0].velocity = 0.2 * Vec3(0.4, 0.0, 0.3);
-        // A marble overlapping the tumbler's side, moving into it.
+        // A marble overlapping the lower sphere at O's height, moving into it (the push
+        // out is then horizontal and costs no height, so its speed is left alone).
         w.spawnMarble(Vec3(-0.22, -0.8, 0.02), Vec3(3.0, 0.5, -0.2));
         const Ball& ball = w.balls()[0];
+        const Vec3 half(0, 0.5 * s.physics.gravity * s.physics.dt / s.physics.substeps, 0);
+        auto midStep = [&] { return ball.velocity - half; };
         auto kinetic = [&] {
             const Vec3& om = w.tumblers()[0].angularVelocity;
-            return 0.5 * ball.mass() * glm::dot(ball.velocity, ball.velocity) + 0.5 * glm::dot(om, w.rollingInertia(0) * om);
+            const Vec3 u = midStep();
+            return 0.5 * ball.mass() * glm::dot(u, u) + 0.5 * glm::dot(om, w.rollingInertia(0) * om);
         };
         // Where the contact will be: the resolve pushes the ball out first, along n.
         const double d = w.tumblerSdf(0, ball.position);
         const Vec3 n = w.tumblerNormal(0, ball.position), h = ball.position - d * n;
-        const double vnBefore = glm::dot(ball.velocity - w.pointVelocity(0, h), n);
+        const double vnBefore = glm::dot(midStep() - w.pointVelocity(0, h), n);
         const double e0 = kinetic();
         REQUIRE(vnBefore < -1.0);
         REQUIRE(w.resolveBallTumblerContact(0, 0));
-        const double vnAfter = glm::dot(ball.velocity - w.pointVelocity(0, h), n);
+        const double vnAfter = glm::dot(midStep() - w.pointVelocity(0, h), n);
         INFO("e = " << e << ": vn " << vnBefore << " -> " << vnAfter);
         CHECK(vnAfter == Approx(-e * vnBefore).margin(1e-12));
         CHECK(glm::length(w.pointVelocity(0, w.floorContact(0))) < 1e-12);
@@ -193,6 +197,7 @@ TEST_CASE("stress: long runs, many balls, fast bodies, extreme dt stay finite an
         Scene s = emptyScene();
         s.physics.dt = 1.0 / 30;
         s.physics.substeps = 1;
+        s.physics.maxSubsteps = 1;  // no adaptive sub-steps: the swept test alone
         s.tumblers.push_back({{0.0, 0.0}, {0.0, 0.0}, {1, 0, 0}});
         s.fireballs.push_back({{-0.8, -0.75, 0.0}, {50.0, 0.0, 0.0}, 0.06, {1, 0.5, 0}});
         World w(s);

@@ -16,6 +16,7 @@
 //     "physics": {
 //       "dt": 0.0041667,            // one frame (s), (0, 0.1]
 //       "substeps": 4,              // sub-steps per frame, 1..64
+//       "max_substeps": 256,        // adaptive ceiling for fast bodies, ≥ 1 (≤ substeps: off)
 //       "gravity": 9.81,            // m/s², [0, 100]
 //       "friction": 0.005,          // μ of the rocking damping (SPEC §4.1), [0, 10]
 //       "wall_decay": 0.5,          // tumbler velocity kept after hitting a wall, [0, 1]
@@ -83,6 +84,7 @@ struct Scene {
     struct Physics {
         double dt = 1.0 / 240.0;
         int substeps = 4;
+        int maxSubsteps = 256;      // adaptive sub-stepping's ceiling (≤ substeps: fixed count)
         double gravity = 9.81;
         double friction = 0.005;    // μ of the rocking/rolling damping (decel. μg/b rad/s²)
         double wallDecay = 0.5;     // tumbler-wall restitution: normal velocity kept after a hit

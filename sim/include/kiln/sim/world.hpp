@@ -122,8 +122,11 @@ public:
     // Starts over from `scene` (seed included).
     void reset(const Scene& scene);
     void reset() { reset(scene_); }
-    // One fixed frame: `scene.physics.substeps` sub-steps of dt / substeps.
+    // One fixed frame: `scene.physics.substeps` sub-steps of dt / substeps, or more
+    // (up to scene.physics.maxSubsteps) when a body is fast enough to outrun its contacts.
     void step();
+    // The sub-step count step() would use for a frame of `frame` seconds now.
+    int substepsFor(double frame) const;
 
     const Scene& scene() const { return scene_; }
     const RoundCone& shape() const { return shape_; }
@@ -198,6 +201,9 @@ public:
     double tumblerJellett(int i) const;
     // Σ tumblerEnergy + Σ ball mass × ballEnergy (the balls' modified energy E′).
     double totalEnergy() const;
+    // Energy (mass × E′) that burnt marbles took with them when they crumbled to ash:
+    // totalEnergy() + removedBallEnergy() is what an energy-conserving run keeps.
+    double removedBallEnergy() const { return removedBallEnergy_; }
     // Velocity of the material point of tumbler i at world point p.
     Vec3 pointVelocity(int i, const Vec3& p) const;
     // World-space inverse inertia of tumbler i about its centre of mass.
@@ -229,8 +235,12 @@ private:
     void updateSleep(Tumbler& t, double dt);
     void collideTumblerWalls(int i);
     void collideTumblerFloor(int i);
-    void separateBallsFromTumblers();
-    void stepBall(Ball& ball, double dt);
+    void landOnSide(int i);
+    bool separateBallsFromTumblers();
+    void settleTumblers();
+    void stepBall(int ball, double dt);
+    void bounceOffTumblers(int ball, double gy, double dt, Vec3& v0);
+    void moveBallKeepingEnergy(Ball& ball, const Vec3& to);
     void collideBallTumblers(int ball);
     void collideBallPairs();
     void collideBallLamp(Ball& ball);
@@ -251,6 +261,7 @@ private:
     std::vector<Particle> particles_;
     Rng rng_;
     double time_ = 0.0;
+    double removedBallEnergy_ = 0.0;
     uint64_t steps_ = 0;
     uint64_t bodiesVersion_ = 0, particlesVersion_ = 0;
     bool bodiesMoved_ = false, particlesChanged_ = false;
