@@ -147,7 +147,7 @@ void World::moveBallKeepingEnergy(Ball& ball, const Vec3& to) {
     // the ball's height and so its E′ = ½|u|² + g·y + const (u = v − ½gΔt·ŷ). Scaling u
     // to pay for the height keeps E′; only a ball too slow to pay gains the rest.
     const double g = ball.kind == BallKind::Fireball ? 0.0 : scene_.physics.gravity;
-    const double dt = scene_.physics.dt / std::max(1, scene_.physics.substeps);
+    const double dt = substepDt_;
     const Vec3 half(0, 0.5 * g * dt, 0);
     const Vec3 u = ball.velocity - half;
     const double u2 = glm::dot(u, u), paid = 2.0 * g * (to.y - ball.position.y);
@@ -168,7 +168,7 @@ bool World::resolveBallTumblerContact(int bi, int i) {
     // The impulse acts on the mid-step velocity u = v − ½gΔt·ŷ, the one the ball's E′
     // counts (½|u|² + g·y), so an elastic hit moves energy without making or losing any.
     const double g = ball.kind == BallKind::Fireball ? 0.0 : scene_.physics.gravity;
-    const Vec3 u = ball.velocity - Vec3(0, 0.5 * g * scene_.physics.dt / std::max(1, scene_.physics.substeps), 0);
+    const Vec3 u = ball.velocity - Vec3(0, 0.5 * g * substepDt_, 0);
     const double vn = glm::dot(u - pointVelocity(i, h), n);
     if (vn >= 0.0) return true;
     // The tumbler answers with its rolling-constrained effective mass (the floor holds
@@ -281,7 +281,7 @@ bool World::resolveBallBallContact(int ai, int bi) {
     }
     // The impulse from the mid-step velocities u = v − ½gΔt·ŷ (what E′ counts); for two
     // balls under the same gravity that is the same relative velocity as v's.
-    const double halfDt = 0.5 * scene_.physics.dt / std::max(1, scene_.physics.substeps);
+    const double halfDt = 0.5 * substepDt_;
     const double vn = glm::dot(b.velocity - a.velocity, n) + (ga - gb) * halfDt * n.y;
     if (vn < 0) {
         const double j = -(1.0 + scene_.physics.restitution.ballBall) * vn / (1.0 / ma + 1.0 / mb);

@@ -44,7 +44,7 @@ uint64_t World::stateHash() const {
         f.add(uint64_t(p.kind));
     }
     f.add(rng_.state()), f.add(rng_.stream());
-    f.add(time_), f.add(steps_), f.add(removedBallEnergy_);
+    f.add(time_), f.add(steps_), f.add(removedBallEnergy_), f.add(substepDt_);
     f.add(drag_.tumbler), f.add(uint64_t(drag_.mode)), f.add(drag_.planeY), f.add(drag_.offset);
     return f.h;
 }
@@ -52,7 +52,7 @@ uint64_t World::stateHash() const {
 double World::ballEnergy(int i) const {
     const Ball& b = balls_[size_t(i)];
     const double g = b.kind == BallKind::Fireball ? 0.0 : scene_.physics.gravity;
-    const double dt = scene_.physics.dt / std::max(1, scene_.physics.substeps);
+    const double dt = substepDt_;
     return 0.5 * glm::dot(b.velocity, b.velocity) + g * b.position.y - 0.5 * g * dt * b.velocity.y;
 }
 

@@ -37,7 +37,8 @@ double fourSphereContact(const World& w, int a, int b, const RoundCone& shape, V
 
 }  // namespace
 
-void World::collideTumblerWalls(int i) {
+bool World::collideTumblerWalls(int i) {
+    bool pushed = false;
     // Both spheres against the four side walls: a horizontal push of O (the tumbler keeps
     // its orientation, so nothing else moves back in), then, if the touching point moves
     // into the wall, a rolling-constrained impulse that leaves it with −wall_decay times
@@ -55,6 +56,7 @@ void World::collideTumblerWalls(int i) {
         }
         if (touching < 0) continue;
         t.position[axis] += push;
+        pushed = true;
         Vec3 n(0.0);  // into the box
         n[axis] = push < 0 ? -1.0 : 1.0;
         const Vec3 at = (touching == 0 ? t.position : t.upperCentre(shape_)) - n * radii[touching];
@@ -63,6 +65,7 @@ void World::collideTumblerWalls(int i) {
         if (vn < 0.0 && k > 1e-12) applyRollingImpulse(i, at, (-(1.0 + scene_.physics.wallDecay) * vn / k) * n);
         wake(i);
     }
+    return pushed;
 }
 
 void World::collideTumblerFloor(int i) {

@@ -39,6 +39,7 @@ void World::reset(const Scene& scene) {
     rng_.reseed(scene.physics.seed);
     time_ = 0.0;
     removedBallEnergy_ = 0.0;
+    substepDt_ = scene.physics.dt / std::max(1, scene.physics.substeps);
     steps_ = 0;
     ++bodiesVersion_;
     ++particlesVersion_;
@@ -131,14 +132,16 @@ void World::wake(int i) {
 }
 
 void World::settleTumblers() {
-    // A wall push can move a tumbler back into its neighbour: repeat pairs + walls (a
-    // few passes) until no pair overlaps by more than 0.1 mm. Walls always run last.
-    for (int pass = 0; pass < 4; ++pass) {
+    // A wall push can move a tumbler back into its neighbour: repeat pairs + walls (up to
+    // 8 passes) until a pass finds no pair overlapping by more than 0.1 mm and moves no
+    // tumbler off a wall. Walls always run last, so containment is exact regardless.
+    for (int pass = 0; pass < 8; ++pass) {
         double deepest = 0.0;
         for (int a = 0; a < int(tumblers_.size()); ++a)
             for (int b = a + 1; b < int(tumblers_.size()); ++b) deepest = std::min(deepest, resolveTumblerPair(a, b));
-        for (int i = 0; i < int(tumblers_.size()); ++i) collideTumblerWalls(i);
-        if (deepest > -1e-4) break;
+        bool pushed = false;
+        for (int i = 0; i < int(tumblers_.size()); ++i) pushed = collideTumblerWalls(i) || pushed;
+        if (deepest > -1e-4 && !pushed) break;
     }
 }
 
@@ -164,6 +167,14 @@ int World::substepsFor(double frame) const {
 void World::step() {
     const int n = substepsFor(scene_.physics.dt);
     const double dt = scene_.physics.dt / n;
+    if (dt != substepDt_) {
+        // Semi-implicit Euler carries the mid-step velocity u = v − ½gΔt·ŷ (what E′ =
+        // ½|u|² + g·y counts): keep u when the sub-step changes, so the switch costs no
+        // energy (v itself shifts by ½g·(Δt_new − Δt_old)).
+        for (Ball& b : balls_)
+            if (b.kind != BallKind::Fireball) b.velocity.y += 0.5 * scene_.physics.gravity * (dt - substepDt_);
+        substepDt_ = dt;
+    }
     bodiesMoved_ = particlesChanged_ = false;
     for (int k = 0; k < n; ++k) substep(dt);
     updateParticles(scene_.physics.dt);

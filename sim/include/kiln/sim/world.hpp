@@ -216,7 +216,8 @@ public:
     uint64_t stateHash() const;
 
     // A ball's modified mechanical energy per unit mass in free flight,
-    // E′ = ½|v|² + g·y − ½·g·Δt·v_y with Δt the sub-step (gravity-free balls: ½|v|²).
+    // E′ = ½|v|² + g·y − ½·g·Δt·v_y with Δt the sub-step in effect (the scene's dt /
+    // substeps unless adaptive sub-steps are running; gravity-free balls: ½|v|²).
     // Semi-implicit Euler keeps it exactly between bounces, and the time-symmetric
     // wall bounce keeps it exactly across them (PHYSICS.md).
     double ballEnergy(int ball) const;
@@ -233,7 +234,7 @@ private:
     void stepTumblerRolling(int i, double dt);
     void applyFriction(Tumbler& t, double dt) const;
     void updateSleep(Tumbler& t, double dt);
-    void collideTumblerWalls(int i);
+    bool collideTumblerWalls(int i);  // true if it pushed
     void collideTumblerFloor(int i);
     void landOnSide(int i);
     bool separateBallsFromTumblers();
@@ -262,6 +263,7 @@ private:
     Rng rng_;
     double time_ = 0.0;
     double removedBallEnergy_ = 0.0;
+    double substepDt_ = 0.0;  // the sub-step in effect (adaptive sub-steps change it)
     uint64_t steps_ = 0;
     uint64_t bodiesVersion_ = 0, particlesVersion_ = 0;
     bool bodiesMoved_ = false, particlesChanged_ = false;
