@@ -43,7 +43,7 @@ void World::bounceOffTumblers(int bi, double gy, double dt, Vec3& v0) {
     Ball& ball = balls_[size_t(bi)];
     const Vec3 x0 = ball.position;
     for (int i = 0; i < int(tumblers_.size()); ++i) {
-        if (glm::length(x0 - tumblers_[size_t(i)].position) > shape_.top() + shape_.b() + ball.radius + glm::length(v0) * dt + 0.5 * std::abs(gy) * dt * dt)
+        if (glm::length(x0 - tumblers_[size_t(i)].position) > std::max(shape_.top(), shape_.b()) + ball.radius + glm::length(v0) * dt + 0.5 * std::abs(gy) * dt * dt)
             continue;
         const Vec3 x1 = x0 + (v0 + Vec3(0, gy * dt, 0)) * dt;
         if (tumblerSdf(i, x1) >= ball.radius) continue;
@@ -159,7 +159,7 @@ void World::moveBallKeepingEnergy(Ball& ball, const Vec3& to) {
 bool World::resolveBallTumblerContact(int bi, int i) {
     Ball& ball = balls_[size_t(bi)];
     const Tumbler& t = tumblers_[size_t(i)];
-    if (glm::length(ball.position - t.position) > shape_.top() + shape_.b() + ball.radius) return false;
+    if (glm::length(ball.position - t.position) > std::max(shape_.top(), shape_.b()) + ball.radius) return false;
     const double d = tumblerSdf(i, ball.position);
     if (d >= ball.radius) return false;
     const Vec3 n = tumblerNormal(i, ball.position);
@@ -193,6 +193,7 @@ bool World::separateBallsFromTumblers() {
         Ball& ball = balls_[size_t(bi)];
         const double limit = 1.0 - ball.radius;
         for (int i = 0; i < int(tumblers_.size()); ++i) {
+            if (glm::length(ball.position - tumblers_[size_t(i)].position) > std::max(shape_.top(), shape_.b()) + ball.radius) continue;
             const double d = tumblerSdf(i, ball.position);
             if (d >= ball.radius - 1e-9) continue;
             const Vec3 n = tumblerNormal(i, ball.position);
@@ -215,6 +216,13 @@ bool World::separateBallsFromTumblers() {
 void World::collideBallPairs() {
     const int n = int(balls_.size());
     if (n < 2) return;
+    if (n <= 32) {
+        // Few balls: every pair in index order is cheaper than clearing and counting a
+        // grid of up to 64³ cells (and just as deterministic).
+        for (int i = 0; i < n; ++i)
+            for (int j = i + 1; j < n; ++j) resolveBallBallContact(i, j);
+        return;
+    }
     // Uniform grid over the box, cell ≥ the largest diameter: a ball can only touch
     // balls in its own and the 26 neighbouring cells. Counting sort keeps it O(n) and
     // deterministic (pairs are visited in ball index order).
