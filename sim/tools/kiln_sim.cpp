@@ -1,5 +1,5 @@
 // kiln-sim — the simulation without OpenGL: run a scene and print its state hash and
-// invariants, or run the physics benchmarks (tables + CSV). Every failure exits
+// invariants, or run the physics benchmarks (tables, CSV, PNG plots). Every failure exits
 // non-zero with one line "kiln-sim: error: ..." on stderr.
 #include <chrono>
 #include <cerrno>
@@ -25,9 +25,12 @@ usage:
       hash and the invariants (finite state, |q| - 1, containment); exits 1 if an
       invariant is broken
   kiln-sim bench [--scene FILE] [--out DIR] [--quick]
-      steps/s for the default scene and 10/100/1000 balls, position error vs dt
-      (against dt/64 runs) with the observed order, four-sphere vs exact tumbler
-      contact; prints tables and writes CSV to DIR (default bench-out/)
+      cost per frame for the scene and 10/100/1000 balls; the tumbler's rocking
+      period (vs the quadrature reference) and 3D energy/Jellett drift vs dt and
+      sub-steps with time per simulated second and the observed order; marbles vs
+      the closed-form free fall; four-sphere vs exact tumbler contact (poses and a
+      crowded scene); prints tables, writes CSV and PNG plots to DIR (default
+      bench-out/)
   kiln-sim --help
 
 The default scene is scenes/cornell.json of the source tree.
