@@ -88,6 +88,13 @@ bool writeLogLogPng(const std::string& path, const LogLogPlot& plot, std::string
     c.text(left, 14, plot.title, 3);
     c.text(left + 4, top - 20, plot.yLabel);
     c.text((left + right) / 2 - c.textWidth(plot.xLabel) / 2, bottom + 36, plot.xLabel);
+    // The legend goes in the top corner with fewer points under it.
+    int leftCount = 0, rightCount = 0;
+    for (auto& s : plot.series)
+        for (auto& [x, y] : s.points)
+            if (x > 0 && y > 0 && py(std::log10(y)) < (top + bottom) / 2.0)
+                (px(std::log10(x)) < (left + right) / 2.0 ? leftCount : rightCount)++;
+    const bool legendLeft = leftCount < rightCount;
     int legendY = top + 10;
     for (auto& s : plot.series) {
         bool have = false;
@@ -99,7 +106,7 @@ bool writeLogLogPng(const std::string& path, const LogLogPlot& plot, std::string
             c.rect(int(X) - 3, int(Y) - 3, int(X) + 3, int(Y) + 3, s.color);
             ox = X, oy = Y, have = true;
         }
-        const int lx = right - 16 - c.textWidth(s.label) - 30;
+        const int lx = legendLeft ? left + 16 : right - 16 - c.textWidth(s.label) - 30;
         c.rect(lx, legendY + 2, lx + 20, legendY + 8, s.color);
         c.text(lx + 28, legendY, s.label);
         legendY += 22;
