@@ -156,10 +156,19 @@ bool balls(const Json& root, const std::string& key, std::vector<Scene::BallSpec
     return true;
 }
 
-}  // namespace
+bool restitution(const Json& physics, Scene::Physics::Restitution& e, SceneError& error) {
+    const Json* o = nullptr;
+    if (!object(physics, "restitution", "physics.restitution", error, o)) return false;
+    if (!o) return true;
+    Reader r{*o, "physics.restitution", error, {}};
+    return r.number("ball_box", e.ballBox, 0, 1) && r.number("ball_lamp", e.ballLamp, 0, 1) &&
+           r.number("ball_ball", e.ballBall, 0, 1) && r.number("ball_tumbler", e.ballTumbler, 0, 1) &&
+           r.number("tumbler_tumbler", e.tumblerTumbler, 0, 1) && r.number("tumbler_floor", e.tumblerFloor, 0, 1) &&
+           r.finish();
+}
 
-bool parseScene(const std::string& text, Scene& out, SceneError& error) {
-    Json root;
+// Parses the JSON text; a syntax error becomes "line L, column C: ...".
+bool parseJson(const std::string& text, Json& root, SceneError& error) {
     try {
         root = Json::parse(text);
     } catch (const Json::parse_error& e) {
@@ -180,7 +189,10 @@ bool parseScene(const std::string& text, Scene& out, SceneError& error) {
         error = {"", std::string("the scene must be a JSON object, got ") + typeName(root)};
         return false;
     }
-    Scene s;
+    return true;
+}
+
+bool readBox(const Json& root, Scene& s, SceneError& error) {
     const Json* o = nullptr;
     if (!object(root, "box", "box", error, o)) return false;
     if (o) {
@@ -199,6 +211,11 @@ bool parseScene(const std::string& text, Scene& out, SceneError& error) {
         }
         if (!r.finish()) return false;
     }
+    return true;
+}
+
+bool readLamp(const Json& root, Scene& s, SceneError& error) {
+    const Json* o = nullptr;
     if (!object(root, "lamp", "lamp", error, o)) return false;
     if (o) {
         Reader r{*o, "lamp", error, {}};
@@ -206,22 +223,34 @@ bool parseScene(const std::string& text, Scene& out, SceneError& error) {
             !r.vec<3>("color", s.lamp.color, 0, 1) || !r.number("intensity", s.lamp.intensity, 0, 1e4) || !r.finish())
             return false;
     }
+    return true;
+}
+
+bool readPhysics(const Json& root, Scene& s, SceneError& error) {
+    const Json* o = nullptr;
     if (!object(root, "physics", "physics", error, o)) return false;
     if (o) {
-        Reader r{*o, "physics", error, {}};
+        Reader r{*o, "physics", error, {"restitution"}};
         int mode = int(s.physics.tumblerMode), contact = int(s.physics.tumblerContact);
         double seed = double(s.physics.seed);
         if (!r.number("dt", s.physics.dt, 1e-5, 0.1) || !r.integer("substeps", s.physics.substeps, 1, 64) ||
+            !r.integer("max_substeps", s.physics.maxSubsteps, 1, 4096) ||
             !r.number("gravity", s.physics.gravity, 0, 100) || !r.number("friction", s.physics.friction, 0, 10) ||
             !r.number("wall_decay", s.physics.wallDecay, 0, 1) ||
             !r.choice("tumbler_mode", {"seed", "accurate"}, mode) ||
             !r.choice("tumbler_contact", {"four_spheres", "exact"}, contact) ||
             !r.number("ballast_h", s.physics.ballastH, -0.19, 0.19) || !r.number("seed", seed, 0, 4294967295.0) || !r.finish())
             return false;
+        if (!restitution(*o, s.physics.restitution, error)) return false;
         s.physics.tumblerMode = TumblerMode(mode);
         s.physics.tumblerContact = TumblerContact(contact);
         s.physics.seed = uint64_t(seed);
     }
+    return true;
+}
+
+bool readShape(const Json& root, Scene& s, SceneError& error) {
+    const Json* o = nullptr;
     if (!object(root, "tumbler_shape", "tumbler_shape", error, o)) return false;
     if (o) {
         Reader r{*o, "tumbler_shape", error, {}};
@@ -235,6 +264,10 @@ bool parseScene(const std::string& text, Scene& out, SceneError& error) {
         }
         s.tumblerShape.alpha = alphaDeg * 3.14159265358979323846 / 180.0;
     }
+    return true;
+}
+
+bool readTumblers(const Json& root, Scene& s, SceneError& error) {
     if (!root.contains("tumblers") || !root["tumblers"].is_array()) {
         error = {"tumblers", root.contains("tumblers") ? std::string("expected an array, got ") + typeName(root["tumblers"])
                                                        : "missing (the list of tumblers, possibly empty)"};
@@ -263,30 +296,44 @@ bool parseScene(const std::string& text, Scene& out, SceneError& error) {
         }
         s.tumblers.push_back(spec);
     }
-    // With its tilt, the upper sphere must be inside too, and no two tumblers may overlap.
-    {
-        const auto& ts = s.tumblerShape;
-        const RoundCone shape(ts.b, ts.t, ts.alpha);
-        std::vector<std::pair<glm::dvec3, glm::dvec3>> axes;
-        for (size_t i = 0; i < s.tumblers.size(); ++i) {
-            const auto& spec = s.tumblers[i];
-            const glm::dvec3 o(spec.position.x, -1.0 + ts.b, spec.position.y);
-            const glm::dquat q = glm::angleAxis(spec.tilt.y, glm::dvec3(0, 0, 1)) * glm::angleAxis(spec.tilt.x, glm::dvec3(1, 0, 0));
-            const glm::dvec3 top = o + q * glm::dvec3(0, shape.upperCentre(), 0);
-            const std::string path = "tumblers[" + std::to_string(i) + "]";
-            for (int a = 0; a < 3; ++a)
-                if (std::abs(top[a]) > 1.0 - ts.t || (a == 1 && top.y < -1.0 + ts.t)) {
-                    error = {path + ".tilt", "with this tilt the tumbler's upper sphere is outside the box"};
-                    return false;
-                }
-            for (size_t j = 0; j < axes.size(); ++j)
-                if (roundConeSeparation(axes[j].first, axes[j].second, ts.b, ts.t, o, top, ts.b, ts.t).distance < 0.0) {
-                    error = {path + ".position", "overlaps tumblers[" + std::to_string(j) + "]"};
-                    return false;
-                }
-            axes.emplace_back(o, top);
-        }
+    return true;
+}
+
+// With its tilt, the upper sphere must be inside too, and no two tumblers may overlap.
+bool checkTumblerPoses(const Scene& s, SceneError& error) {
+    const auto& ts = s.tumblerShape;
+    const RoundCone shape(ts.b, ts.t, ts.alpha);
+    std::vector<std::pair<glm::dvec3, glm::dvec3>> axes;
+    for (size_t i = 0; i < s.tumblers.size(); ++i) {
+        const auto& spec = s.tumblers[i];
+        const glm::dvec3 o(spec.position.x, -1.0 + ts.b, spec.position.y);
+        const glm::dquat q = glm::angleAxis(spec.tilt.y, glm::dvec3(0, 0, 1)) * glm::angleAxis(spec.tilt.x, glm::dvec3(1, 0, 0));
+        const glm::dvec3 top = o + q * glm::dvec3(0, shape.upperCentre(), 0);
+        const std::string path = "tumblers[" + std::to_string(i) + "]";
+        for (int a = 0; a < 3; ++a)
+            if (std::abs(top[a]) > 1.0 - ts.t || (a == 1 && top.y < -1.0 + ts.t)) {
+                error = {path + ".tilt", "with this tilt the tumbler's upper sphere is outside the box"};
+                return false;
+            }
+        for (size_t j = 0; j < axes.size(); ++j)
+            if (roundConeSeparation(axes[j].first, axes[j].second, ts.b, ts.t, o, top, ts.b, ts.t).distance < 0.0) {
+                error = {path + ".position", "overlaps tumblers[" + std::to_string(j) + "]"};
+                return false;
+            }
+        axes.emplace_back(o, top);
     }
+    return true;
+}
+
+}  // namespace
+
+bool parseScene(const std::string& text, Scene& out, SceneError& error) {
+    Json root;
+    if (!parseJson(text, root, error)) return false;
+    Scene s;
+    if (!readBox(root, s, error) || !readLamp(root, s, error) || !readPhysics(root, s, error) ||
+        !readShape(root, s, error) || !readTumblers(root, s, error) || !checkTumblerPoses(s, error))
+        return false;
     if (!balls(root, "marbles", s.marbles, 0.05, error) || !balls(root, "fireballs", s.fireballs, 0.06, error))
         return false;
     Reader top{root, "", error, {"box", "lamp", "physics", "tumbler_shape", "tumblers", "marbles", "fireballs", "$schema"}};

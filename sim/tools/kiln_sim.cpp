@@ -1,5 +1,5 @@
 // kiln-sim — the simulation without OpenGL: run a scene and print its state hash and
-// invariants, or run the physics benchmarks (tables + CSV). Every failure exits
+// invariants, or run the physics benchmarks (tables, CSV, PNG plots). Every failure exits
 // non-zero with one line "kiln-sim: error: ..." on stderr.
 #include <chrono>
 #include <cerrno>
@@ -25,9 +25,12 @@ usage:
       hash and the invariants (finite state, |q| - 1, containment); exits 1 if an
       invariant is broken
   kiln-sim bench [--scene FILE] [--out DIR] [--quick]
-      steps/s for the default scene and 10/100/1000 balls, position error vs dt
-      (against dt/64 runs) with the observed order, four-sphere vs exact tumbler
-      contact; prints tables and writes CSV to DIR (default bench-out/)
+      cost per frame for the scene and 10/100/1000 balls; the tumbler's rocking
+      period (vs the quadrature reference) and 3D energy/Jellett drift vs dt and
+      sub-steps with time per simulated second and the observed order; marbles vs
+      the closed-form free fall; four-sphere vs exact tumbler contact (poses and a
+      crowded scene); prints tables, writes CSV and PNG plots to DIR (default
+      bench-out/)
   kiln-sim --help
 
 The default scene is scenes/cornell.json of the source tree.
@@ -49,6 +52,38 @@ bool parseCount(const std::string& v, long long& out) {
 }
 
 }  // namespace
+
+// `kiln-sim run`: steps the world and checks the invariants every frame.
+int runScene(const Scene& scene, const std::string& scenePath, long long steps) {
+    World world(scene);
+    double worstQ = 0, worstOut = 0;
+    bool finite = true;
+    const auto t0 = std::chrono::steady_clock::now();
+    for (long long i = 0; i < steps && finite; ++i) {
+        world.step();
+        worstQ = std::max(worstQ, world.maxQuaternionError());
+        worstOut = std::max(worstOut, world.maxContainmentViolation());
+        finite = world.allFinite();
+    }
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    int asleep = 0;
+    for (auto& t : world.tumblers()) asleep += t.asleep;
+    std::printf("scene %s  seed %llu  mode %s  contact %s\n", scenePath.c_str(), (unsigned long long)scene.physics.seed,
+                scene.physics.tumblerMode == TumblerMode::Seed ? "seed" : "accurate",
+                scene.physics.tumblerContact == TumblerContact::Exact ? "exact" : "four_spheres");
+    std::printf("steps %lld  t %.4f s  hash %016llx  (%.0f steps/s)\n", steps, world.time(),
+                (unsigned long long)world.stateHash(), seconds > 0 ? double(steps) / seconds : 0.0);
+    std::printf("tumblers %zu (%d asleep)  balls %zu  particles %zu\n", world.tumblers().size(), asleep,
+                world.balls().size(), world.particles().size());
+    std::printf("invariants over the run: finite %s  max | |q| - 1 | %.3g  max containment violation %.3g m\n",
+                finite ? "yes" : "NO", worstQ, worstOut);
+    // Bounds: quaternions are renormalised every sub-step (1e-6 is generous), containment
+    // is exact per sphere up to rounding (1e-9 m).
+    if (!finite) return fail("the state became NaN/Inf");
+    if (worstQ > 1e-6) return fail("a quaternion norm drifted beyond 1e-6");
+    if (worstOut > 1e-9) return fail("a body left the box by more than 1e-9 m");
+    return 0;
+}
 
 int main(int argc, char** argv) {
     std::vector<std::string> args(argv + 1, argv + argc);
@@ -98,33 +133,5 @@ int main(int argc, char** argv) {
     }
 
     if (command == "bench") return runBenchmarks(scene, outDir, quick);
-
-    World world(scene);
-    double worstQ = 0, worstOut = 0;
-    bool finite = true;
-    const auto t0 = std::chrono::steady_clock::now();
-    for (long long i = 0; i < steps && finite; ++i) {
-        world.step();
-        worstQ = std::max(worstQ, world.maxQuaternionError());
-        worstOut = std::max(worstOut, world.maxContainmentViolation());
-        finite = world.allFinite();
-    }
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    int asleep = 0;
-    for (auto& t : world.tumblers()) asleep += t.asleep;
-    std::printf("scene %s  seed %llu  mode %s  contact %s\n", scenePath.c_str(), (unsigned long long)scene.physics.seed,
-                scene.physics.tumblerMode == TumblerMode::Seed ? "seed" : "accurate",
-                scene.physics.tumblerContact == TumblerContact::Exact ? "exact" : "four_spheres");
-    std::printf("steps %lld  t %.4f s  hash %016llx  (%.0f steps/s)\n", steps, world.time(),
-                (unsigned long long)world.stateHash(), seconds > 0 ? double(steps) / seconds : 0.0);
-    std::printf("tumblers %zu (%d asleep)  balls %zu  particles %zu\n", world.tumblers().size(), asleep,
-                world.balls().size(), world.particles().size());
-    std::printf("invariants over the run: finite %s  max | |q| - 1 | %.3g  max containment violation %.3g m\n",
-                finite ? "yes" : "NO", worstQ, worstOut);
-    // Bounds: quaternions are renormalised every sub-step (1e-6 is generous), containment
-    // is exact per sphere up to rounding (1e-9 m).
-    if (!finite) return fail("the state became NaN/Inf");
-    if (worstQ > 1e-6) return fail("a quaternion norm drifted beyond 1e-6");
-    if (worstOut > 1e-9) return fail("a body left the box by more than 1e-9 m");
-    return 0;
+    return runScene(scene, scenePath, steps);
 }

@@ -85,7 +85,7 @@ TEST_CASE("known separations: upright side by side, overlapping, coincident", "[
     CHECK(sep.distance == Approx(-0.4).margin(1e-12));
 }
 
-TEST_CASE("the four-sphere approximation never under-estimates; its error measured", "[sim][contact]") {
+TEST_CASE("the four-sphere approximation never under-estimates, its error measured", "[sim][contact]") {
     RoundCone shape;
     Rng rng(5);
     const Vec3 up(0, shape.upperCentre(), 0);

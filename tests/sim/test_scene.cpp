@@ -21,6 +21,30 @@ TEST_CASE("the shipped scene loads", "[sim][scene]") {
     CHECK(s.tumblers.size() == 5);
     CHECK(s.fireballs.size() == 2);
     CHECK(s.lamp.center.y > 1.0);  // the light sits outside the box
+    // It states the restitution of every contact kind: all elastic.
+    CHECK(s.physics.restitution.ballBox == 1.0);
+    CHECK(s.physics.restitution.tumblerTumbler == 1.0);
+    CHECK(s.physics.restitution.tumblerFloor == 1.0);
+    CHECK(s.physics.wallDecay == 1.0);
+}
+
+TEST_CASE("physics.restitution and max_substeps are read and checked", "[sim][scene]") {
+    Scene s;
+    SceneError e;
+    REQUIRE(parseScene(R"({"tumblers": [], "physics": {"max_substeps": 8,
+        "restitution": {"ball_box": 0.9, "ball_lamp": 0.8, "ball_ball": 0.7, "ball_tumbler": 0.6,
+                        "tumbler_tumbler": 0.25, "tumbler_floor": 0.1}}})", s, e));
+    CHECK(s.physics.maxSubsteps == 8);
+    CHECK(s.physics.restitution.ballBox == 0.9);
+    CHECK(s.physics.restitution.ballLamp == 0.8);
+    CHECK(s.physics.restitution.ballBall == 0.7);
+    CHECK(s.physics.restitution.ballTumbler == 0.6);
+    CHECK(s.physics.restitution.tumblerTumbler == 0.25);
+    CHECK(s.physics.restitution.tumblerFloor == 0.1);
+    CHECK(errorOf(R"({"tumblers": [], "physics": {"restitution": {"ball_box": 1.5}}})") ==
+          "scenes/x.json: physics.restitution.ball_box: must be within [0.000000, 1.000000], got 1.5");
+    CHECK(errorOf(R"({"tumblers": [], "physics": {"restitution": {"bounce": 1}}})") ==
+          "scenes/x.json: physics.restitution.bounce: unknown key");
 }
 
 TEST_CASE("bad scene files give the JSON path and what is wrong", "[sim][scene]") {

@@ -16,13 +16,21 @@
 //     "physics": {
 //       "dt": 0.0041667,            // one frame (s), (0, 0.1]
 //       "substeps": 4,              // sub-steps per frame, 1..64
+//       "max_substeps": 256,        // adaptive ceiling for fast bodies, ≥ 1 (≤ substeps: off)
 //       "gravity": 9.81,            // m/s², [0, 100]
 //       "friction": 0.005,          // μ of the rocking damping (SPEC §4.1), [0, 10]
 //       "wall_decay": 0.5,          // tumbler velocity kept after hitting a wall, [0, 1]
 //       "tumbler_mode": "seed" | "accurate",         // restoring impulse | weighted base
 //       "tumbler_contact": "four_spheres" | "exact", // tumbler-vs-tumbler method
 //       "ballast_h": 0.05,          // accurate mode: centre of mass this far below O
-//       "seed": 1                   // random generator seed (integer ≥ 0)
+//       "seed": 1,                  // random generator seed (integer ≥ 0)
+//       "restitution": {            // normal restitution e ∈ [0, 1] of each contact kind,
+//         "ball_box": 1,            //   honoured exactly: v_n after = −e · v_n before
+//         "ball_lamp": 1,           //   (relative normal velocity at the contact point;
+//         "ball_ball": 1,           //   tumblers answer with their rolling-constrained
+//         "ball_tumbler": 1,        //   effective mass). Balls: 1 (SPEC §4.2, no loss).
+//         "tumbler_tumbler": 0.5,   //   Tumbler vs wall: "wall_decay" above.
+//         "tumbler_floor": 0 }      //   A toppled tumbler's side/upper sphere landing.
 //     },
 //     "tumbler_shape": { "b": 0.2, "t": 0.1, "alpha_deg": 20, "mass": 1 },
 //     "tumblers": [                               // required (may be empty)
@@ -76,14 +84,20 @@ struct Scene {
     struct Physics {
         double dt = 1.0 / 240.0;
         int substeps = 4;
+        int maxSubsteps = 256;      // adaptive sub-stepping's ceiling (≤ substeps: fixed count)
         double gravity = 9.81;
         double friction = 0.005;    // μ of the rocking/rolling damping (decel. μg/b rad/s²)
-        double wallDecay = 0.5;     // tumbler velocity kept after hitting a wall
+        double wallDecay = 0.5;     // tumbler-wall restitution: normal velocity kept after a hit
         TumblerMode tumblerMode = TumblerMode::Accurate;
         TumblerContact tumblerContact = TumblerContact::Exact;
         double ballastH = 0.05;     // accurate mode: centre of mass this far below O (negative:
                                     // above; a uniform tumbler's is −0.0521, and it cannot stand)
         uint64_t seed = 1;
+        // Normal restitution per contact kind (the tumbler-wall one is wallDecay).
+        struct Restitution {
+            double ballBox = 1.0, ballLamp = 1.0, ballBall = 1.0, ballTumbler = 1.0;
+            double tumblerTumbler = 0.5, tumblerFloor = 0.0;
+        } restitution;
     } physics;
     struct TumblerShape {
         double b = 0.2, t = 0.1, alpha = 0.3490658503988659, mass = 1.0;

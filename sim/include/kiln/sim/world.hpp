@@ -8,8 +8,8 @@
 //   if (!r) { std::cerr << r.error.toString("scenes/cornell.json") << "\n"; return 1; }
 //   kiln::sim::World world(r.scene);
 //   each frame (unless paused): world.step();          // dt = scene.physics.dt
-//   if (world.bodiesVersion() != seen) upload tumblers()/balls() (or the *Instances()
-//   float arrays below); likewise particlesVersion() for particles().
+//   if (world.bodiesVersion() != seen) upload tumblers()/balls() (the host writes its
+//   own instance records from them); likewise particlesVersion() for particles().
 //
 // Model (SPEC §4): a tumbler's lower-sphere centre O stays at y = −1 + b and it rolls
 // without slipping; "seed" mode puts the centre of mass at O and adds the seed's
@@ -44,6 +44,9 @@ public:
     double uniform(double lo, double hi) { return lo + (hi - lo) * uniform(); }
     Vec3 inUnitBall();
     Vec3 onUnitSphere();
+    // The generator's full state (for World::stateHash).
+    uint64_t state() const { return state_; }
+    uint64_t stream() const { return inc_; }
 
 private:
     uint64_t state_ = 0, inc_ = 0;
@@ -97,29 +100,6 @@ struct Particle {
     Vec3 emission() const;
 };
 
-// GPU-ready instance records (float, tightly packed, 16-byte multiples) written by
-// World::write*Instances; upload the vector's data() as an instance buffer.
-struct TumblerInstance {
-    float model[16];      // column-major model matrix (local → world)
-    float color[3];
-    uint32_t asleep;      // 1 when the tumbler sleeps
-};
-struct BallInstance {
-    float position[3];
-    float radius;
-    float albedo[3];
-    uint32_t kind;        // BallKind
-    float emissive[3];    // colour, multiply by strength
-    float strength;
-};
-struct ParticleInstance {
-    float position[3];
-    float radius;
-    float emission[3];    // emitted radiance (already scaled)
-    uint32_t kind;        // ParticleKind
-};
-static_assert(sizeof(TumblerInstance) == 80 && sizeof(BallInstance) == 48 && sizeof(ParticleInstance) == 32);
-
 // Solves K·j = Δv for a symmetric positive semi-definite 3×3 K (an effective-mass
 // matrix, K = (1/m)𝟙 − [r]×I⁻¹[r]×). When K is singular or nearly so (relative to its
 // scale) it returns the minimum-norm least-squares solution (pseudo-inverse, eigenvalues
@@ -142,8 +122,11 @@ public:
     // Starts over from `scene` (seed included).
     void reset(const Scene& scene);
     void reset() { reset(scene_); }
-    // One fixed frame: `scene.physics.substeps` sub-steps of dt / substeps.
+    // One fixed frame: `scene.physics.substeps` sub-steps of dt / substeps, or more
+    // (up to scene.physics.maxSubsteps) when a body is fast enough to outrun its contacts.
     void step();
+    // The sub-step count step() would use for a frame of `frame` seconds now.
+    int substepsFor(double frame) const;
 
     const Scene& scene() const { return scene_; }
     const RoundCone& shape() const { return shape_; }
@@ -156,11 +139,6 @@ public:
     std::vector<Ball>& balls() { return balls_; }
     const std::vector<Ball>& balls() const { return balls_; }
     const std::vector<Particle>& particles() const { return particles_; }
-
-    // Contiguous float records for instanced drawing (cleared, then filled).
-    void writeTumblerInstances(std::vector<TumblerInstance>& out) const;
-    void writeBallInstances(std::vector<BallInstance>& out) const;
-    void writeParticleInstances(std::vector<ParticleInstance>& out) const;
 
     // The particle pool's size: particles_ never grows beyond it (no reallocation).
     static constexpr size_t kMaxParticles = 4096;
@@ -200,8 +178,32 @@ public:
     // Resolves tumblers a and b with the scene's method; returns the separation it saw
     // (negative: overlap) or +inf when they are too far apart to test.
     double resolveTumblerPair(int a, int b);
-    // Applies impulse j at world point p to tumbler i (no constraints).
+    // Applies impulse j at world point p to tumbler i as a free body (no floor; the
+    // seed's model). Contacts use applyRollingImpulse.
     void applyImpulse(int i, const Vec3& p, const Vec3& j);
+    // Applies impulse j at world point p to tumbler i while it rolls on the floor: the
+    // floor answers with whatever impulse at the contact point keeps it rolling without
+    // slipping, so Δω = A⁻¹·((p − P) × j) with A = rollingInertia(i), and the velocity
+    // stays consistent with the constraint (nothing is discarded at the next sub-step).
+    void applyRollingImpulse(int i, const Vec3& p, const Vec3& j);
+    // The floor contact P = O − b·ŷ (the lowest point of the lower sphere).
+    Vec3 floorContact(int i) const;
+    // Inertia about the floor contact, world frame: A = I_G + m(|r|²𝟙 − r·rᵀ), r = G − P.
+    // The rolling body's kinetic energy is ½ωᵀAω and its angular momentum about P is Aω.
+    Mat3 rollingInertia(int i) const;
+    // Inverse effective mass of tumbler i at world point p along unit n given that it
+    // rolls: n·Δv_p per unit impulse along n, = (ρ×n)ᵀA⁻¹(ρ×n), ρ = p − P.
+    double rollingInverseMass(int i, const Vec3& p, const Vec3& n) const;
+    // Mechanical energy of tumbler i (rolling kinetic ½ωᵀAω + m·g·G_y, floor at y = −1
+    // is not subtracted) and Jellett's quantity L_G·(G − P) = L_P·(G − P), conserved by
+    // frictionless rolling of a body of revolution on a sphere base (PHYSICS.md).
+    double tumblerEnergy(int i) const;
+    double tumblerJellett(int i) const;
+    // Σ tumblerEnergy + Σ ball mass × ballEnergy (the balls' modified energy E′).
+    double totalEnergy() const;
+    // Energy (mass × E′) that burnt marbles took with them when they crumbled to ash:
+    // totalEnergy() + removedBallEnergy() is what an energy-conserving run keeps.
+    double removedBallEnergy() const { return removedBallEnergy_; }
     // Velocity of the material point of tumbler i at world point p.
     Vec3 pointVelocity(int i, const Vec3& p) const;
     // World-space inverse inertia of tumbler i about its centre of mass.
@@ -209,11 +211,13 @@ public:
     Vec3 centreOfMass(int i) const;
     double tumblerMass() const { return scene_.tumblerShape.mass; }
 
-    // FNV-1a over the raw state (bodies, balls, particles, RNG, time).
+    // FNV-1a over all of the state: every field of every tumbler, ball and particle,
+    // the generator, time, step count and the drag in progress.
     uint64_t stateHash() const;
 
     // A ball's modified mechanical energy per unit mass in free flight,
-    // E′ = ½|v|² + g·y − ½·g·Δt·v_y with Δt the sub-step (gravity-free balls: ½|v|²).
+    // E′ = ½|v|² + g·y − ½·g·Δt·v_y with Δt the sub-step in effect (the scene's dt /
+    // substeps unless adaptive sub-steps are running; gravity-free balls: ½|v|²).
     // Semi-implicit Euler keeps it exactly between bounces, and the time-symmetric
     // wall bounce keeps it exactly across them (PHYSICS.md).
     double ballEnergy(int ball) const;
@@ -226,9 +230,18 @@ public:
 private:
     void substep(double dt);
     void stepTumbler(int i, double dt);
-    void collideTumblerWalls(int i);
+    void stepTumblerSeed(int i, double dt);
+    void stepTumblerRolling(int i, double dt);
+    void applyFriction(Tumbler& t, double dt) const;
+    void updateSleep(Tumbler& t, double dt);
+    bool collideTumblerWalls(int i);  // true if it pushed
     void collideTumblerFloor(int i);
-    void stepBall(Ball& ball, double dt);
+    void landOnSide(int i);
+    bool separateBallsFromTumblers();
+    void settleTumblers();
+    void stepBall(int ball, double dt);
+    void bounceOffTumblers(int ball, double gy, double dt, Vec3& v0);
+    void moveBallKeepingEnergy(Ball& ball, const Vec3& to);
     void collideBallTumblers(int ball);
     void collideBallPairs();
     void collideBallLamp(Ball& ball);
@@ -249,6 +262,8 @@ private:
     std::vector<Particle> particles_;
     Rng rng_;
     double time_ = 0.0;
+    double removedBallEnergy_ = 0.0;
+    double substepDt_ = 0.0;  // the sub-step in effect (adaptive sub-steps change it)
     uint64_t steps_ = 0;
     uint64_t bodiesVersion_ = 0, particlesVersion_ = 0;
     bool bodiesMoved_ = false, particlesChanged_ = false;
