@@ -39,7 +39,7 @@ std::string pipelineWithExposure(double exposure) {
 
 }  // namespace
 
-TEST_CASE("recompiling keeps textures; a pass whose parameters changed runs again", "[runtime][gl]") {
+TEST_CASE("recompiling keeps textures, and a pass whose parameters changed runs again", "[runtime][gl]") {
     Fixture f;
     std::string errors;
     REQUIRE(f.app.runtime().loadPipelineText(pipelineWithExposure(1.0), "a.json", errors));

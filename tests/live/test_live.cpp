@@ -157,7 +157,7 @@ TEST_CASE("a pipeline edit changes the plan and keeps unchanged passes' textures
     CHECK(box.app.runtime().findTexture("gbuffer", "albedo")->id == albedo);
 }
 
-TEST_CASE("a rebuilt module is swapped in with its parameters kept; a broken one is refused", "[live][gl]") {
+TEST_CASE("a rebuilt module is swapped in with its parameters kept, a broken one is refused", "[live][gl]") {
     const std::string pipeline = R"({"output": "tint.color",
         "passes": [{"id": "tint", "module": "live_tint", "params": {"level": 0.25}}]})";
     const fs::path v1 = fs::path(LIVE_MODULE_BUILDS) / "tint_v1.so", v2 = fs::path(LIVE_MODULE_BUILDS) / "tint_v2.so";
@@ -176,7 +176,7 @@ TEST_CASE("a rebuilt module is swapped in with its parameters kept; a broken one
     CHECK(near(box.centre(), {0.0f, 0.25f, 1.0f}));  // the previous module keeps running
 }
 
-TEST_CASE("a scene edit resets the world; an invalid scene keeps it", "[live][gl]") {
+TEST_CASE("a scene edit resets the world, an invalid scene keeps it", "[live][gl]") {
     Sandbox box("scene-edit");
     const fs::path scene = box.root / "scenes/cornell.json";
     REQUIRE(box.app.scene().sim().tumblers().size() == 5);
