@@ -7,23 +7,12 @@
 #include <string>
 
 #include "kiln/sim/world.hpp"
+#include "support.hpp"
 
 using namespace kiln::sim;
+using namespace kiln::sim::test;
 
 namespace {
-
-#ifdef KILN_SANITIZED_BUILD
-constexpr int kScale = 10;
-#else
-constexpr int kScale = 1;
-#endif
-
-Scene shippedScene() {
-    Scene s;
-    std::string error;
-    REQUIRE(loadScene(std::string(KILN_SOURCE_DIR) + "/scenes/cornell.json", s, error));
-    return s;
-}
 
 double deepestTumblerOverlap(const World& w) {
     double worst = 0.0;

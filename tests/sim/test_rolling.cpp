@@ -7,16 +7,12 @@
 #include <vector>
 
 #include "kiln/sim/world.hpp"
+#include "support.hpp"
 
 using namespace kiln::sim;
+using namespace kiln::sim::test;
 
 namespace {
-
-#ifdef KILN_SANITIZED_BUILD
-constexpr int kScale = 10;
-#else
-constexpr int kScale = 1;
-#endif
 
 constexpr double kDeg = M_PI / 180.0;
 

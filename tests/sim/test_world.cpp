@@ -4,27 +4,16 @@
 #include <cmath>
 
 #include "kiln/sim/world.hpp"
+#include "support.hpp"
 
 using namespace kiln::sim;
+using namespace kiln::sim::test;
 
 namespace {
-
-#ifdef KILN_SANITIZED_BUILD
-constexpr int kScale = 10;
-#else
-constexpr int kScale = 1;
-#endif
 
 Scene emptyScene() {
     Scene s;
     s.physics.friction = 0.0;
-    return s;
-}
-
-Scene defaultScene() {
-    Scene s;
-    std::string error;
-    REQUIRE(loadScene(std::string(KILN_SOURCE_DIR) + "/scenes/cornell.json", s, error));
     return s;
 }
 
@@ -178,17 +167,17 @@ TEST_CASE("stress: long runs, many balls, fast bodies, extreme dt stay finite an
     SECTION("1e6 sub-steps of the default scene") {
         // 250 000 frames × 4 sub-steps = 1e6 sub-steps (17 min of simulated time); a
         // tenth under sanitizers (KILN_SANITIZED_BUILD).
-        World w(defaultScene());
+        World w(shippedScene());
         run(w, 250000 / kScale, "default scene");
         CHECK(w.particles().size() <= 4096);
     }
     SECTION("200 marbles") {
-        World w(defaultScene());
+        World w(shippedScene());
         for (int i = 0; i < 200; ++i) w.spawnRandom(BallKind::Marble);
         run(w, 2000 / kScale, "200 marbles");
     }
     SECTION("fireballs at 50 m/s do not tunnel") {
-        Scene s = defaultScene();
+        Scene s = shippedScene();
         s.fireballs.push_back({{0.0, 0.3, 0.0}, {50.0, 20.0, -35.0}, 0.06, {1, 0.5, 0}});
         World w(s);
         run(w, 5000 / kScale, "fast fireball");
@@ -209,7 +198,7 @@ TEST_CASE("stress: long runs, many balls, fast bodies, extreme dt stay finite an
     }
     SECTION("dt from 1/1000 to 1/30") {
         for (double dt : {1.0 / 1000, 1.0 / 240, 1.0 / 60, 1.0 / 30}) {
-            Scene s = defaultScene();
+            Scene s = shippedScene();
             s.physics.dt = dt;
             s.physics.substeps = 1;
             World w(s);
@@ -247,7 +236,7 @@ TEST_CASE("stress: long runs, many balls, fast bodies, extreme dt stay finite an
 
 TEST_CASE("determinism: same scene and seed give the same hash, another seed differs", "[sim][world]") {
     auto run = [](uint64_t seed) {
-        Scene s = defaultScene();
+        Scene s = shippedScene();
         s.physics.seed = seed;
         World w(s);
         for (int i = 0; i < 1500; ++i) w.step();
@@ -497,7 +486,7 @@ TEST_CASE("sleeping tumblers wake when a marble lands on them", "[sim][world]") 
 
 TEST_CASE("determinism with inputs: drags and spawns replay bit-identically", "[sim][world]") {
     auto run = [] {
-        World w(defaultScene());
+        World w(shippedScene());
         for (int i = 0; i < 300; ++i) {
             w.step();
             if (i == 50) w.spawnRandom(BallKind::Marble);
@@ -517,7 +506,7 @@ TEST_CASE("determinism with inputs: drags and spawns replay bit-identically", "[
 
 TEST_CASE("a tumbler's model matrix maps its local frame to the world", "[sim][world]") {
     // The host builds its instance records from Tumbler::modelMatrix (float, column-major).
-    World w(defaultScene());
+    World w(shippedScene());
     for (int i = 0; i < 100; ++i) w.step();
     for (const Tumbler& t : w.tumblers()) {
         float m[16];
