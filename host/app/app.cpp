@@ -2,6 +2,8 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include <cmath>
+
 #include "kiln/log.hpp"
 
 namespace kiln::app {
@@ -83,6 +85,8 @@ SceneView App::buildView() {
     v.frame.lightColor = glm::vec4(look.lampColor * look.lampIntensity, look.lampIntensity);
     v.frame.woodLight = glm::vec4(look.woodLight, look.woodRingFrequency);
     v.frame.woodDark = glm::vec4(look.woodDark, 0.0f);
+    v.frame.tumblerShape = glm::vec4(look.tumblerB, look.tumblerT, look.tumblerAlpha,
+                                     (look.tumblerB - look.tumblerT) / std::sin(look.tumblerAlpha));
 
     if (v.frame.viewProj != lastViewProj_) lastViewProj_ = v.frame.viewProj, ++cameraVersion_;
     for (int i = 0; i < kSceneGeometryCount; ++i) {

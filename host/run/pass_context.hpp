@@ -18,6 +18,8 @@ namespace kiln::run {
 class SceneDraw {
 public:
     virtual void draw(const DrawFilter&) const = 0;
+    // Binds the instance buffer at kInstanceBinding (every pass may read it).
+    virtual void bindInstances() const = 0;
 
 protected:
     ~SceneDraw() = default;

@@ -230,6 +230,7 @@ void Runtime::runPass(size_t i, const FrameResources& shared, const SceneView& v
     }
 
     resetGlState();
+    shared.scene.bindInstances();
     slot.error.clear();
     HostPassContext ctx(shared, slot, planned, view, frame);
     const auto cpuStart = std::chrono::steady_clock::now();

@@ -15,6 +15,8 @@ SceneLook lookOf(const sim::Scene& scene) {
     look.woodLight = glm::vec3(scene.box.floorWood.light);
     look.woodDark = glm::vec3(scene.box.floorWood.dark);
     look.woodRingFrequency = float(scene.box.floorWood.ringFrequency);
+    look.wallEmission = glm::vec3(scene.box.emission);
+    look.closed = scene.box.closed;
     look.lampCentre = glm::vec3(scene.lamp.center);
     look.lampRadius = float(scene.lamp.radius);
     look.lampColor = glm::vec3(scene.lamp.color);

@@ -54,7 +54,7 @@ void SceneRenderer::setLook(const SceneLook& look) {
     buildMeshes(look);
     staticInstances_.clear();
     auto wall = [&](glm::mat4 m, glm::vec3 albedo, float material) {
-        staticInstances_.push_back({m, glm::vec4(albedo, material), glm::vec4(0.0f)});
+        staticInstances_.push_back({m, glm::vec4(albedo, material), glm::vec4(look.wallEmission, 0.0f)});
     };
     // The quad faces +y at y = 0; each wall is it rotated so its normal points into the room.
     const glm::mat4 I(1.0f);
@@ -63,13 +63,15 @@ void SceneRenderer::setLook(const SceneLook& look) {
     wall(glm::rotate(glm::translate(I, {-1, 0, 0}), glm::radians(-90.0f), {0, 0, 1}), look.left, 0.0f);  // left
     wall(glm::rotate(glm::translate(I, {1, 0, 0}), glm::radians(90.0f), {0, 0, 1}), look.right, 0.0f);   // right
     wall(glm::rotate(glm::translate(I, {0, 0, -1}), glm::radians(90.0f), {1, 0, 0}), look.other, 0.0f);  // back
+    if (look.closed) wall(glm::rotate(glm::translate(I, {0, 0, 1}), glm::radians(-90.0f), {1, 0, 0}), look.other, 0.0f);
+    const size_t walls = staticInstances_.size();
     // The lamp dome: its mesh is already in world space.
     staticInstances_.push_back(
         {I, glm::vec4(look.lampColor, 0.0f), glm::vec4(look.lampColor * look.lampIntensity, 0.0f)});
     // New meshes change what every category looks like, whatever its instances say.
     for (int i = 0; i < kSceneGeometryCount; ++i) ++versions_[i], hashes_[i] = 0;
-    noteContents(kSceneBox, staticInstances_.data(), 5);
-    noteContents(kSceneLamp, staticInstances_.data() + 5, 1);
+    noteContents(kSceneBox, staticInstances_.data(), walls);
+    noteContents(kSceneLamp, staticInstances_.data() + walls, 1);
     dirty_ = true;
 }
 
@@ -145,10 +147,14 @@ void SceneRenderer::upload() {
     dirty_ = false;
 }
 
+void SceneRenderer::bindInstances() const {
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kInstanceBinding, instanceBuffer_.id());
+}
+
 void SceneRenderer::draw(const DrawFilter& filter) const {
     if (!instanceBuffer_) return;
     glBindVertexArray(vao_.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kInstanceBinding, instanceBuffer_.id());
+    bindInstances();
     for (auto& g : groups_) {
         if (!(filter.categories & g.category)) continue;
         if (!g.anyLod && g.lod != filter.lod) continue;

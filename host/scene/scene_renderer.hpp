@@ -25,6 +25,8 @@ struct SceneLook {
     glm::vec3 other{0.85f, 0.82f, 0.78f};  // back wall, ceiling (the floor is wood)
     glm::vec3 woodLight{0.72f, 0.52f, 0.32f}, woodDark{0.45f, 0.28f, 0.15f};
     float woodRingFrequency = 14.0f;
+    glm::vec3 wallEmission{0.0f};  // radiance every wall emits
+    bool closed = false;           // a front wall at z = +1 (colour `other`)
     glm::vec3 lampCentre{0.0f, 1.1f, 0.0f};
     float lampRadius = 0.35f;
     glm::vec3 lampColor{1.0f, 0.95f, 0.85f};
@@ -57,6 +59,7 @@ public:
     void upload();
     // Instanced draws of every group matching the filter with the current program.
     void draw(const DrawFilter&) const override;
+    void bindInstances() const override;
     // Instances of one geometry category (kSceneBox ... kSceneParticles).
     uint32_t count(SceneCategory single) const { return counts_[sceneCategoryIndex(single)]; }
     // Changes whenever that geometry category's instance contents changed.

@@ -11,4 +11,5 @@ layout(std140, binding = 0) uniform KilnFrame {
     vec4 u_time;         // seconds, dt, frame index
     vec4 u_woodLight;    // the floor's wood (scene file box.floor_wood): rgb, w = rings per metre
     vec4 u_woodDark;     // rgb
+    vec4 u_tumblerShape; // round cone: b, t, α (rad), y_t (upper centre above the lower)
 };

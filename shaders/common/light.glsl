@@ -33,17 +33,40 @@ vec4 lightSpace(vec3 world) {
     return vec4(ndc * 0.5 + 0.5, inside);
 }
 
-// Light arriving from the lamp at a surface point p with unit normal n, before
-// visibility: u_lightColor · cos θ · the seed's "directional" falloff (the lamp is a
-// hemisphere opening downwards, so light leaving it at a grazing angle to −y is
-// dimmer and the wall tops get shade). Diffuse outgoing radiance = albedo/π · this ·
-// visibility. Shared by composite (with PCF) and voxelize (hard shadow), so the
-// voxels and the screen agree on the direct light.
+// The lamp, defined once (scene file `lamp`): the part of the sphere u_lightPos (xyz
+// centre, w radius) below the ceiling y = 1, a Lambertian emitter of radiance
+// u_lightColor.rgb. Its irradiance at p on a surface with unit normal n, before
+// visibility, is E = ∫_cap L · cos θ_p · cos θ_q / d² dA, here by a fixed
+// KILN_LAMP_SAMPLES-point quadrature: equal-area points on the cap (a sphere's area is
+// uniform in height, Archimedes) on a golden-angle spiral. The cap is convex, so its
+// points facing p (cos θ_q > 0) are exactly the visible ones. Diffuse outgoing
+// radiance = albedo/π · E · visibility. Shared by composite (PCF shadows) and voxelize
+// (hard shadows); passes/reference samples the same emitter, so the rasterized frame
+// and the reference agree on the lamp without a fudge factor.
+#ifndef KILN_LAMP_SAMPLES
+#define KILN_LAMP_SAMPLES 32
+#endif
+const float kCeilingY = 1.0;
+
 vec3 lampLight(vec3 p, vec3 n) {
-    vec3 l = normalize(u_lightPos.xyz - p);
-    float cosTheta = max(dot(n, l), 0.0);
-    float directional = smoothstep(0.0, 1.0, clamp(dot(-l, vec3(0.0, -1.0, 0.0)), 0.0, 1.0));
-    return u_lightColor.rgb * cosTheta * directional;
+    const vec3 c = u_lightPos.xyz;
+    const float radius = u_lightPos.w;
+    const float yLow = c.y - radius, yHigh = min(kCeilingY, c.y + radius);
+    if (yHigh <= yLow) return vec3(0.0);
+    const float dy = (yHigh - yLow) / float(KILN_LAMP_SAMPLES);
+    const vec2 turn = vec2(cos(2.39996323), sin(2.39996323));  // the golden angle
+    vec2 dir = vec2(1.0, 0.0);
+    float sum = 0.0;
+    for (int i = 0; i < KILN_LAMP_SAMPLES; ++i) {
+        const float h = yLow + (float(i) + 0.5) * dy - c.y;
+        const vec3 nq = vec3(dir.x * sqrt(max(radius * radius - h * h, 0.0)), h, dir.y * sqrt(max(radius * radius - h * h, 0.0))) / radius;
+        const vec3 w = c + nq * radius - p;
+        const float d2 = dot(w, w);
+        sum += max(dot(n, w), 0.0) * max(-dot(nq, w), 0.0) / (d2 * d2);
+        dir = vec2(dir.x * turn.x - dir.y * turn.y, dir.x * turn.y + dir.y * turn.x);
+    }
+    const float area = 6.28318531 * radius * (yHigh - yLow);
+    return u_lightColor.rgb * (sum * area / float(KILN_LAMP_SAMPLES));
 }
 
 // Fraction of the lamp that sees p through a shadow map of the casters: a k×k

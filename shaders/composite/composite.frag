@@ -1,9 +1,11 @@
 #version 450 core
-// Direct diffuse light from the lamp (≈ a point light at its centre, I = k_d·I_l·cos θ)
-// with the seed's "directional" attenuation by the angle between the light direction
-// and +y (the hemisphere lamp shades the wall tops), plus emission, indirect, bloom.
+// Direct diffuse light from the lamp (the emitter of common/light.glsl, shadowed by a
+// PCF lookup from its centre), plus albedo × indirect irradiance, emission and bloom.
+// `hdr` is the radiance estimate before bloom and exposure, the image the error
+// metrics compare with the reference.
 #include "common/frame.glsl"
 #include "common/light.glsl"
+#include "common/tonemap.glsl"
 
 in vec2 v_uv;
 layout(location = 0) out vec4 o_color;
@@ -20,7 +22,7 @@ layout(binding = 6) uniform sampler2D u_bloom;
 uniform float u_exposure;
 uniform float u_ambient;
 uniform float u_gamma;
-uniform int u_tonemap;
+uniform int u_tonemap;   // kTonemapAces, kTonemapReinhard, kTonemapClamp
 uniform int u_pcf;
 uniform float u_shadowBias;
 uniform float u_indirectStrength;
@@ -40,14 +42,6 @@ vec3 worldPosition(vec2 uv, float depth) {
     return p.xyz / p.w;
 }
 
-vec3 tonemap(vec3 x) {
-    if (u_tonemap == 0) {  // ACES filmic fit (Narkowicz 2015)
-        return clamp((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14), 0.0, 1.0);
-    }
-    if (u_tonemap == 1) return x / (1.0 + x);
-    return clamp(x, 0.0, 1.0);
-}
-
 void main() {
     vec4 n4 = texture(u_normal, v_uv);
     vec3 emissive = texture(u_emissive, v_uv).rgb;
@@ -56,17 +50,17 @@ void main() {
         vec3 albedo = texture(u_albedo, v_uv).rgb;
         vec3 p = worldPosition(v_uv, texture(u_depth, v_uv).r);
         vec3 n = normalize(n4.xyz);
-        float cosTheta = max(dot(n, normalize(u_lightPos.xyz - p)), 0.0);
-        float visible = cosTheta > 0.0 ? lightVisibility(p + n * 0.004) : 0.0;
-        vec3 direct = albedo / 3.14159265 * lampLight(p, n) * visible;
+        vec3 irradiance = lampLight(p, n);
+        float visible = max(irradiance.r, max(irradiance.g, irradiance.b)) > 0.0 ? lightVisibility(p + n * 0.004) : 0.0;
+        vec3 direct = albedo / 3.14159265 * irradiance * visible;
         vec3 indirect = albedo * u_indirectStrength * texture(u_indirect, v_uv).rgb;
 #if KILN_HAS_INDIRECT == 0
         indirect = albedo * u_ambient;
 #endif
         radiance = direct + indirect;
     }
-    radiance += emissive + texture(u_bloom, v_uv).rgb;
-    radiance *= u_exposure;
+    radiance += emissive;
     o_hdr = vec4(radiance, 1.0);
-    o_color = vec4(pow(tonemap(radiance), vec3(1.0 / u_gamma)), 1.0);
+    vec3 shown = (radiance + texture(u_bloom, v_uv).rgb) * u_exposure;
+    o_color = vec4(displayEncode(shown, u_tonemap, u_gamma), 1.0);
 }

@@ -100,6 +100,14 @@ struct Reader {
             }
         return fail(at(key), "expected one of " + list + ", got " + v.dump());
     }
+    bool boolean(const std::string& key, bool& out) {
+        known.insert(key);
+        if (!j.contains(key)) return true;
+        const Json& v = j[key];
+        if (!v.is_boolean()) return fail(at(key), std::string("expected true or false, got ") + typeName(v));
+        out = v.get<bool>();
+        return true;
+    }
     // Unknown keys are typos until proven otherwise.
     bool finish() {
         known.insert("note");
@@ -198,7 +206,8 @@ bool readBox(const Json& root, Scene& s, SceneError& error) {
     if (o) {
         Reader r{*o, "box", error, {}};
         if (!r.vec<3>("left", s.box.left, 0, 1) || !r.vec<3>("right", s.box.right, 0, 1) ||
-            !r.vec<3>("other", s.box.other, 0, 1))
+            !r.vec<3>("other", s.box.other, 0, 1) || !r.vec<3>("emission", s.box.emission, 0, 1e4) ||
+            !r.boolean("closed", s.box.closed))
             return false;
         r.known.insert("floor_wood");
         const Json* w = nullptr;

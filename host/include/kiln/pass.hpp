@@ -98,7 +98,9 @@
 //   size; depth test off, depth func LESS, depth writes on; blending off, blend func
 //   (ONE, ZERO); face culling off, cull face BACK; polygon offset fill off, offset 0;
 //   scissor and stencil tests off; colour writes on; program 0; vertex array 0;
-//   texture units 0–15 and image units 0–7 unbound; the frame uniform block bound.
+//   texture units 0–15 and image units 0–7 unbound; the frame uniform block and the
+//   scene's instance buffer (common/instances.glsl, SSBO binding 0) bound, so a compute
+//   pass can read the scene too (SceneView::firstInstance says where a category starts).
 //   Anything else you change (clip control, point size, SSBO bindings other than 0,
 //   memory barriers) is yours to restore or to set every time.
 //
@@ -125,7 +127,7 @@
 namespace kiln {
 
 // Bump when anything in this header (or what it includes) changes layout or vtables.
-inline constexpr uint32_t kPassAbiVersion = 2;
+inline constexpr uint32_t kPassAbiVersion = 3;
 
 struct TextureRef {
     GLuint id = 0;

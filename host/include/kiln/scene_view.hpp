@@ -41,6 +41,8 @@ struct GpuFrame {
     glm::vec4 time;          // seconds, dt, frame index, unused
     glm::vec4 woodLight;     // the floor's wood grain (scene file box.floor_wood):
     glm::vec4 woodDark;      //   rgb light / dark, woodLight.w = rings per metre
+    glm::vec4 tumblerShape;  // the tumblers' round cone (kiln/sim/shape.hpp): lower radius
+                             //   b, upper radius t, half-angle α (rad), upper centre y_t
 };
 
 inline constexpr unsigned kFrameBinding = 0;      // uniform block
@@ -60,6 +62,13 @@ struct SceneView {
     uint64_t versions[kSceneCategoryCount] = {};
     uint32_t counts[kSceneGeometryCount] = {};  // instances per geometry category
 
+    // The instance buffer holds the geometry categories in bit order (box walls, lamp,
+    // tumblers, marbles, fireballs, particles); this is where `single` starts.
+    uint32_t firstInstance(SceneCategory single) const {
+        uint32_t n = 0;
+        for (int i = 0; i < sceneCategoryIndex(single); ++i) n += counts[i];
+        return n;
+    }
     uint64_t version(SceneCategory single) const { return versions[sceneCategoryIndex(single)]; }
     // Instances in the geometry categories of `mask` (kSceneShadowCasters: tumblers + marbles).
     uint32_t count(uint32_t mask) const {

@@ -9,10 +9,13 @@
 //     "box": {                                   // the Cornell box's look
 //       "left": [r,g,b],  "right": [r,g,b],      // x = −1 wall (orange), x = +1 (sky blue)
 //       "other": [r,g,b],                        // back wall, ceiling (and floor tint)
-//       "floor_wood": { "light": [r,g,b], "dark": [r,g,b], "ring_frequency": 14 }
+//       "floor_wood": { "light": [r,g,b], "dark": [r,g,b], "ring_frequency": 14 },
+//       "emission": [r,g,b],                     // radiance every wall emits (default 0)
+//       "closed": false                          // a front wall at z = +1 (colour "other")
 //     },
-//     "lamp": { "center": [0, 1.1, 0], "radius": 0.35,   // hemisphere (dome reaches y = 0.75)
-//               "color": [r,g,b], "intensity": 4 },      // light position = center (outside)
+//     "lamp": { "center": [0, 1.1, 0], "radius": 0.35,   // sphere clipped by the ceiling: the
+//               "color": [r,g,b], "intensity": 20 },     // dome below y = 1 emits the
+//                                                        // radiance color × intensity
 //     "physics": {
 //       "dt": 0.0041667,            // one frame (s), (0, 0.1]
 //       "substeps": 4,              // sub-steps per frame, 1..64
@@ -74,12 +77,14 @@ struct Scene {
             glm::dvec3 light{0.72, 0.52, 0.32}, dark{0.45, 0.28, 0.15};
             double ringFrequency = 14.0;  // growth rings per metre of radius
         } floorWood;
+        glm::dvec3 emission{0.0};  // radiance of every wall (a white-furnace test sets it)
+        bool closed = false;       // a sixth wall closes the front (camera inside)
     } box;
     struct Lamp {
         glm::dvec3 center{0.0, 1.1, 0.0};
         double radius = 0.35;
         glm::dvec3 color{1.0, 0.95, 0.85};
-        double intensity = 4.0;
+        double intensity = 20.0;
     } lamp;
     struct Physics {
         double dt = 1.0 / 240.0;

@@ -1,0 +1,101 @@
+// reference — the ground truth the rest is measured against (SPEC §7): a progressive
+// path tracer over the analytic scene the simulation holds (walls as planes, marbles,
+// fireballs and particles as spheres, tumblers as exact round cones, the lamp as the
+// sphere below the ceiling), with the rasterizer's materials. The shader
+// (shaders/reference/path.comp) says how it samples.
+//
+// Outputs (RGBA32F, rgb = the running mean, a = paths per pixel so far):
+//   radiance  linear HDR radiance, before bloom and tonemapping (compare composite.hdr)
+//   direct    emission seen by the camera plus the lamp's light on the first surface:
+//             what composite computes directly; radiance − direct is the indirect part
+//
+// It accumulates while nothing it reads changes (the scene's geometry, the lamp, the
+// camera, its own estimator parameters, its output textures) and starts over when
+// anything does; at `max_samples` it stops (nothing to do). Same seed and settings,
+// same image, bit for bit.
+#include <kiln/hash.hpp>
+#include <kiln/pass.hpp>
+
+namespace {
+
+class Reference final : public kiln::Pass {
+public:
+    kiln::PassDeclaration declare() const override {
+        using namespace kiln;
+        PassDeclaration d;
+        d.output({.name = "radiance", .format = Format::RGBA32F, .doc = "mean radiance; a = samples per pixel"})
+            .output({.name = "direct", .format = Format::RGBA32F,
+                     .doc = "emission + the lamp's direct light on the first surface; a = samples"})
+            .param(intParam("samples_per_frame", 1, 1, 256, "paths per pixel added each frame"))
+            .param(intParam("max_samples", 4096, 1, 1 << 20, "stop accumulating at this many paths per pixel"))
+            .param(intParam("max_bounces", 16, 1, 256, "path length limit (Russian roulette ends most paths sooner)"))
+            .param(intParam("roulette_start", 3, 0, 256, "bounce from which Russian roulette may end a path"))
+            .param(intParam("seed", 1, 0, 1 << 30, "random sequence; the same seed gives the same image"))
+            .param(boolParam("jitter", true, "integrate over each pixel's area (off: through pixel centres)"));
+        d.reads = kSceneGeometry | kSceneLight | kSceneCamera;
+        d.timeDependent = true;  // accumulates every frame; resets itself on change
+        return d;
+    }
+
+    void execute(kiln::PassContext& ctx) override {
+        using namespace kiln;
+        GLuint program = ctx.program({.stages = {"reference/path.comp"}});
+        if (!program) return;
+        const TextureRef& radiance = ctx.output("radiance");
+        const TextureRef& direct = ctx.output("direct");
+        const SceneView& scene = ctx.scene();
+
+        const uint64_t key = accumulationKey(ctx, radiance, direct);
+        if (key != key_) key_ = key, samples_ = 0;
+        const int maxSamples = ctx.getInt("max_samples");
+        if (samples_ >= maxSamples) {
+            ctx.nothingToDo("converged: " + std::to_string(samples_) + " paths per pixel");
+            return;
+        }
+        const int batch = std::min(ctx.getInt("samples_per_frame"), maxSamples - samples_);
+
+        glUseProgram(program);
+        GLint first[kSceneGeometryCount], count[kSceneGeometryCount];
+        for (int i = 0; i < kSceneGeometryCount; ++i) {
+            first[i] = GLint(scene.firstInstance(SceneCategory(1u << i)));
+            count[i] = GLint(scene.counts[i]);
+        }
+        glUniform1iv(glGetUniformLocation(program, "u_first"), kSceneGeometryCount, first);
+        glUniform1iv(glGetUniformLocation(program, "u_count"), kSceneGeometryCount, count);
+        glUniform1ui(glGetUniformLocation(program, "u_seed"), GLuint(ctx.getInt("seed")));
+        glUniform1i(glGetUniformLocation(program, "u_sampleBase"), samples_);
+        glUniform1i(glGetUniformLocation(program, "u_samples"), batch);
+        glUniform1i(glGetUniformLocation(program, "u_maxBounces"), ctx.getInt("max_bounces"));
+        glUniform1i(glGetUniformLocation(program, "u_rouletteStart"), ctx.getInt("roulette_start"));
+        glUniform1i(glGetUniformLocation(program, "u_jitter"), ctx.getBool("jitter") ? 1 : 0);
+        glBindImageTexture(0, radiance.id, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+        glBindImageTexture(1, direct.id, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+        glDispatchCompute(GLuint((radiance.width + 7) / 8), GLuint((radiance.height + 7) / 8), 1);
+        glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
+                        GL_TEXTURE_UPDATE_BARRIER_BIT | GL_FRAMEBUFFER_BARRIER_BIT);
+        glBindImageTexture(0, 0, 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
+        glBindImageTexture(1, 0, 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
+        samples_ += batch;
+    }
+
+private:
+    // Everything whose change makes the mean so far wrong.
+    static uint64_t accumulationKey(kiln::PassContext& ctx, const kiln::TextureRef& a, const kiln::TextureRef& b) {
+        using namespace kiln;
+        const SceneView& s = ctx.scene();
+        const int time = sceneCategoryIndex(kSceneTime);
+        uint64_t h = fnv1a(s.counts, sizeof s.counts);
+        for (int i = 0; i < kSceneCategoryCount; ++i)
+            if (i != time) h = fnv1a(&s.versions[i], sizeof s.versions[i], h);
+        const int values[] = {ctx.getInt("max_bounces"), ctx.getInt("roulette_start"), ctx.getInt("seed"),
+                              ctx.getBool("jitter") ? 1 : 0, int(a.id), int(b.id), a.width, a.height};
+        return fnv1a(values, sizeof values, h);
+    }
+
+    uint64_t key_ = 0;
+    int samples_ = 0;
+};
+
+}  // namespace
+
+KILN_PASS_MODULE(reference, Reference)

@@ -1,0 +1,189 @@
+#version 450 core
+// A progressive path tracer over the analytic scene (reference/shapes.glsl) with the
+// rasterizer's materials: Lambert, the instances' albedos, the floor's procedural wood.
+// Each dispatch adds u_samples paths per pixel to a running mean.
+//   - next-event estimation toward the lamp's sphere (uniform in its cone of
+//     directions; a direction whose first hit is the ceiling, not the dome, is simply
+//     occluded) and toward the fireballs, one light picked per vertex;
+//   - BSDF (cosine) sampling, combined with NEE by the power heuristic for the lights
+//     NEE can pick; particles are reached by BSDF sampling only;
+//   - Russian roulette from bounce u_rouletteStart on, so no depth bias below
+//     u_maxBounces.
+// Outputs: radiance = the full estimate; direct = what the rasterizer computes
+// directly: emission seen by the camera plus the lamp's light on the first surface.
+// Deterministic: every random number is a hash of (pixel, sample index, seed).
+layout(local_size_x = 8, local_size_y = 8) in;
+
+#include "common/light.glsl"
+#include "common/wood.glsl"
+#include "reference/shapes.glsl"
+
+layout(binding = 0, rgba32f) uniform image2D u_radiance;
+layout(binding = 1, rgba32f) uniform image2D u_direct;
+
+uniform uint u_seed;
+uniform int u_sampleBase;     // paths already in the mean
+uniform int u_samples;        // paths to add now
+uniform int u_maxBounces;
+uniform int u_rouletteStart;
+uniform bool u_jitter;        // pixel-area integration (the rasterizer samples centres)
+
+const float kPi = 3.14159265358979;
+const float kEpsilon = 1e-4;
+
+// PCG hash (O'Neill; Jarzynski & Olano 2020): one 32-bit state per path.
+uint g_rng;
+uint pcg(uint v) {
+    uint state = v * 747796405u + 2891336453u;
+    uint word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+    return (word >> 22u) ^ word;
+}
+float rand() {
+    g_rng = pcg(g_rng);
+    return float(g_rng >> 8) * (1.0 / 16777216.0);
+}
+
+void basis(vec3 n, out vec3 t, out vec3 b) {  // Duff et al. 2017
+    float s = n.z >= 0.0 ? 1.0 : -1.0;
+    float a = -1.0 / (s + n.z);
+    float c = n.x * n.y * a;
+    t = vec3(1.0 + s * n.x * n.x * a, s * c, -s * n.x);
+    b = vec3(c, s + n.y * n.y * a, -n.y);
+}
+
+vec3 cosineSample(vec3 n) {
+    float u = rand(), v = rand();
+    float r = sqrt(u), phi = 2.0 * kPi * v;
+    vec3 t, b;
+    basis(n, t, b);
+    return normalize(t * (r * cos(phi)) + b * (r * sin(phi)) + n * sqrt(max(0.0, 1.0 - u)));
+}
+
+vec3 albedoAt(int instance, vec3 p) {
+    vec4 a = kiln_instances[instance].albedo;
+    return a.a > 0.5 ? woodGrain(p) : a.rgb;
+}
+vec3 emissionOf(int instance) { return kiln_instances[instance].emissive.rgb; }
+
+// Lights NEE samples: 0 = the lamp, 1..F = fireball F−1. Probability of each.
+int lightCount() { return (u_count[kLamp] > 0 ? 1 : 0) + u_count[kFireballs]; }
+float lightPick() { return 1.0 / float(max(lightCount(), 1)); }
+void lightSphere(int k, out vec3 c, out float r, out int instance) {
+    if (u_count[kLamp] > 0 && k == 0) {
+        c = u_lightPos.xyz, r = u_lightPos.w, instance = u_first[kLamp];
+        return;
+    }
+    instance = u_first[kFireballs] + k - (u_count[kLamp] > 0 ? 1 : 0);
+    mat4 m = kiln_instances[instance].model;
+    c = m[3].xyz, r = length(m[0].xyz);
+}
+bool isNeeLight(int instance) {
+    return (instance == u_first[kLamp] && u_count[kLamp] > 0) ||
+           (instance >= u_first[kFireballs] && instance < u_first[kFireballs] + u_count[kFireballs]);
+}
+// Solid angle density of uniform cone sampling toward the sphere (c, r) from p.
+float coneDensity(vec3 p, vec3 c, float r) {
+    float d2 = dot(c - p, c - p);
+    if (d2 <= r * r) return 0.0;
+    float cosMax = sqrt(1.0 - r * r / d2);
+    return 1.0 / (2.0 * kPi * (1.0 - cosMax));
+}
+float powerHeuristic(float a, float b) { return a * a / (a * a + b * b); }
+
+void tracePath(vec3 o, vec3 d, out vec3 total, out vec3 direct) {
+    total = vec3(0.0), direct = vec3(0.0);
+    vec3 throughput = vec3(1.0);
+    float bsdfPdf = 0.0;      // of the direction that led here (0: camera ray)
+    vec3 previous = o;
+    for (int depth = 0; depth <= u_maxBounces; ++depth) {
+        Hit h = traceScene(o, d, depth == 0 ? 0.0 : kEpsilon);
+        if (h.instance < 0) break;
+        vec3 p = o + h.t * d;
+        vec3 n = dot(h.normal, d) > 0.0 ? -h.normal : h.normal;  // two-sided walls
+        vec3 e = emissionOf(h.instance);
+        if (any(greaterThan(e, vec3(0.0)))) {
+            float w = 1.0;
+            if (depth > 0 && isNeeLight(h.instance)) {
+                vec3 c = h.instance == u_first[kLamp] ? u_lightPos.xyz : kiln_instances[h.instance].model[3].xyz;
+                float r = h.instance == u_first[kLamp] ? u_lightPos.w : length(kiln_instances[h.instance].model[0].xyz);
+                w = powerHeuristic(bsdfPdf, lightPick() * coneDensity(previous, c, r));
+            }
+            vec3 contribution = throughput * e * w;
+            total += contribution;
+            if (depth == 0 || (depth == 1 && h.instance == u_first[kLamp] && u_count[kLamp] > 0)) direct += contribution;
+        }
+        vec3 albedo = albedoAt(h.instance, p);
+        if (all(equal(albedo, vec3(0.0))) || depth == u_maxBounces) break;
+
+        // Next-event estimation: one light, a direction in its cone, one shadow ray.
+        int lights = lightCount();
+        if (lights > 0) {
+            int k = min(int(rand() * float(lights)), lights - 1);
+            vec3 c;
+            float r;
+            int instance;
+            lightSphere(k, c, r, instance);
+            float density = coneDensity(p, c, r);
+            float u = rand(), v = rand();
+            if (density > 0.0) {
+                vec3 axis = normalize(c - p);
+                float cosMax = sqrt(1.0 - r * r / dot(c - p, c - p));
+                float cosT = 1.0 - u * (1.0 - cosMax), sinT = sqrt(max(0.0, 1.0 - cosT * cosT));
+                vec3 t, b;
+                basis(axis, t, b);
+                vec3 l = normalize(t * (sinT * cos(2.0 * kPi * v)) + b * (sinT * sin(2.0 * kPi * v)) + axis * cosT);
+                float cosSurface = dot(n, l);
+                if (cosSurface > 0.0) {
+                    Hit s = traceScene(p, l, kEpsilon);
+                    if (s.instance == instance) {
+                        float lightPdf = lightPick() * density;
+                        float w = powerHeuristic(lightPdf, cosSurface / kPi);
+                        vec3 contribution = throughput * albedo / kPi * emissionOf(instance) * cosSurface * w / lightPdf;
+                        total += contribution;
+                        if (depth == 0 && k == 0 && u_count[kLamp] > 0) direct += contribution;
+                    }
+                }
+            }
+        }
+
+        // Continue: cosine sampling makes the Lambert weight exactly the albedo.
+        vec3 next = cosineSample(n);
+        bsdfPdf = max(dot(n, next), 0.0) / kPi;
+        throughput *= albedo;
+        if (depth >= u_rouletteStart) {
+            float keep = clamp(max(throughput.r, max(throughput.g, throughput.b)), 0.05, 1.0);
+            if (rand() >= keep) break;
+            throughput /= keep;
+        }
+        previous = p;
+        o = p;
+        d = next;
+    }
+}
+
+void main() {
+    ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+    ivec2 size = imageSize(u_radiance);
+    if (any(greaterThanEqual(pixel, size))) return;
+    vec3 sumTotal = vec3(0.0), sumDirect = vec3(0.0);
+    for (int s = 0; s < u_samples; ++s) {
+        uint index = uint(u_sampleBase + s);
+        g_rng = pcg(uint(pixel.x) ^ pcg(uint(pixel.y) ^ pcg(index ^ pcg(u_seed))));
+        vec2 offset = u_jitter ? vec2(rand(), rand()) : vec2(0.5);
+        vec2 ndc = (vec2(pixel) + offset) / vec2(size) * 2.0 - 1.0;
+        vec4 nearPoint = u_invViewProj * vec4(ndc, -1.0, 1.0);
+        vec4 farPoint = u_invViewProj * vec4(ndc, 1.0, 1.0);
+        vec3 o = nearPoint.xyz / nearPoint.w;
+        vec3 d = normalize(farPoint.xyz / farPoint.w - o);
+        vec3 total, direct;
+        tracePath(o, d, total, direct);
+        sumTotal += total;
+        sumDirect += direct;
+    }
+    // Running mean; alpha carries the sample count.
+    float before = float(u_sampleBase), after = float(u_sampleBase + u_samples);
+    vec4 meanTotal = u_sampleBase == 0 ? vec4(0.0) : imageLoad(u_radiance, pixel);
+    vec4 meanDirect = u_sampleBase == 0 ? vec4(0.0) : imageLoad(u_direct, pixel);
+    imageStore(u_radiance, pixel, vec4((meanTotal.rgb * before + sumTotal) / after, after));
+    imageStore(u_direct, pixel, vec4((meanDirect.rgb * before + sumDirect) / after, after));
+}
