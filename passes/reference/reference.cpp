@@ -13,6 +13,8 @@
 // camera, its own estimator parameters, its output textures) and starts over when
 // anything does; at `max_samples` it stops (nothing to do). Same seed and settings,
 // same image, bit for bit.
+#include <algorithm>
+
 #include <kiln/hash.hpp>
 #include <kiln/pass.hpp>
 
@@ -63,14 +65,21 @@ public:
         glUniform1iv(glGetUniformLocation(program, "u_first"), kSceneGeometryCount, first);
         glUniform1iv(glGetUniformLocation(program, "u_count"), kSceneGeometryCount, count);
         glUniform1ui(glGetUniformLocation(program, "u_seed"), GLuint(ctx.getInt("seed")));
-        glUniform1i(glGetUniformLocation(program, "u_sampleBase"), samples_);
-        glUniform1i(glGetUniformLocation(program, "u_samples"), batch);
         glUniform1i(glGetUniformLocation(program, "u_maxBounces"), ctx.getInt("max_bounces"));
         glUniform1i(glGetUniformLocation(program, "u_rouletteStart"), ctx.getInt("roulette_start"));
         glUniform1i(glGetUniformLocation(program, "u_jitter"), ctx.getBool("jitter") ? 1 : 0);
         glBindImageTexture(0, radiance.id, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
         glBindImageTexture(1, direct.id, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
-        glDispatchCompute(GLuint((radiance.width + 7) / 8), GLuint((radiance.height + 7) / 8), 1);
+        // A few paths per dispatch: llvmpipe silently ends a shader loop after 65 535
+        // iterations (counted across the nesting), which dropped every path beyond
+        // ~215 in one invocation here; 8 per dispatch stays far below.
+        constexpr int kPathsPerDispatch = 8;
+        for (int done = 0; done < batch; done += kPathsPerDispatch) {
+            glUniform1i(glGetUniformLocation(program, "u_sampleBase"), samples_ + done);
+            glUniform1i(glGetUniformLocation(program, "u_samples"), std::min(kPathsPerDispatch, batch - done));
+            glDispatchCompute(GLuint((radiance.width + 7) / 8), GLuint((radiance.height + 7) / 8), 1);
+            glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+        }
         glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
                         GL_TEXTURE_UPDATE_BARRIER_BIT | GL_FRAMEBUFFER_BARRIER_BIT);
         glBindImageTexture(0, 0, 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);

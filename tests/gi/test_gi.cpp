@@ -13,61 +13,14 @@
 
 #include "app/app.hpp"
 #include "kiln/image_io.hpp"
-#include "support/headless.hpp"
+#include "gi/rig.hpp"
+
+using namespace kiln::test;
 
 namespace fs = std::filesystem;
 using namespace kiln;
 
 namespace {
-
-std::string writeScene(const std::string& name, const std::string& json) {
-    fs::create_directories(TEST_OUTPUT_DIR);
-    const fs::path file = fs::path(TEST_OUTPUT_DIR) / name;
-    std::ofstream(file) << json;
-    return file.string();
-}
-const char* kEmptyBox = R"({"tumblers": [], "marbles": [], "fireballs": []})";
-
-// One App, paused (time frozen), with the GI test module directory on the path.
-struct Rig {
-    app::App app;
-    int size;
-    Rig(const std::string& scene, int size_) : size(size_) {
-        REQUIRE(test::ensureHeadlessContext());
-        app::Options o;
-        app::applyDefaults(o);
-        if (!scene.empty()) o.scene = scene;
-        o.moduleDir += std::string(":") + GI_TEST_MODULES;
-        o.headless = true;
-        o.live = false;
-        o.width = o.height = size;
-        o.paused = true;
-        o.seed = 1;
-        std::string error;
-        INFO(error);
-        REQUIRE(app.init(o, error));
-    }
-    // Loads a pipeline; `keep` are "pass.output" textures read back (un-culled).
-    void load(const std::string& text, std::vector<std::string> keep = {}) {
-        app.runtime().setRequested(std::move(keep));
-        std::string errors;
-        const bool ok = app.runtime().loadPipelineText(text, "test.json", errors);
-        INFO(errors);
-        REQUIRE(ok);
-    }
-    const TextureRef& tex(const std::string& pass, const std::string& name) {
-        const TextureRef* t = app.runtime().findTexture(pass, name);
-        REQUIRE(t);
-        return *t;
-    }
-    FloatImage image(const std::string& pass, const std::string& name) {
-        const TextureRef& t = tex(pass, name);
-        return readTexture(t.id, t.target, t.format, t.width, t.height);
-    }
-    void checkNoErrors() {
-        for (auto& e : app.runtime().activeErrors()) FAIL(e);
-    }
-};
 
 // A whole level of a 3D RGBA texture, x fastest.
 struct Volume {
@@ -81,10 +34,6 @@ Volume read3d(const TextureRef& t, int level) {
     vol.v.resize(size_t(vol.n) * vol.n * vol.n * 4);
     glGetTextureImage(t.id, level, GL_RGBA, GL_FLOAT, GLsizei(vol.v.size() * sizeof(float)), vol.v.data());
     return vol;
-}
-
-std::string pipeline(const std::string& output, const std::string& passes) {
-    return R"({"output": ")" + output + R"(", "passes": [)" + passes + "]}";
 }
 
 // World position of a pixel from the G-buffer depth and the rig's camera.

@@ -1,0 +1,71 @@
+// The GI tests' rig: one App, headless and paused, with the GI test modules on the
+// module path; scenes written to the test's output directory; pipelines from text.
+#pragma once
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <catch2/catch.hpp>
+
+#include "app/app.hpp"
+#include "kiln/image_io.hpp"
+#include "support/headless.hpp"
+
+namespace kiln::test {
+
+inline std::string writeScene(const std::string& name, const std::string& json) {
+    std::filesystem::create_directories(TEST_OUTPUT_DIR);
+    const std::filesystem::path file = std::filesystem::path(TEST_OUTPUT_DIR) / name;
+    std::ofstream(file) << json;
+    return file.string();
+}
+inline const char* kEmptyBox = R"({"tumblers": [], "marbles": [], "fireballs": []})";
+
+// One App, paused (time frozen), with the GI test module directory on the path.
+struct Rig {
+    app::App app;
+    int size;
+    Rig(const std::string& scene, int size_) : size(size_) {
+        REQUIRE(test::ensureHeadlessContext());
+        app::Options o;
+        app::applyDefaults(o);
+        if (!scene.empty()) o.scene = scene;
+        o.moduleDir += std::string(":") + GI_TEST_MODULES;
+        o.headless = true;
+        o.live = false;
+        o.width = o.height = size;
+        o.paused = true;
+        o.seed = 1;
+        std::string error;
+        INFO(error);
+        REQUIRE(app.init(o, error));
+    }
+    // Loads a pipeline; `keep` are "pass.output" textures read back (un-culled).
+    void load(const std::string& text, std::vector<std::string> keep = {}) {
+        app.runtime().setRequested(std::move(keep));
+        std::string errors;
+        const bool ok = app.runtime().loadPipelineText(text, "test.json", errors);
+        INFO(errors);
+        REQUIRE(ok);
+    }
+    const TextureRef& tex(const std::string& pass, const std::string& name) {
+        const TextureRef* t = app.runtime().findTexture(pass, name);
+        REQUIRE(t);
+        return *t;
+    }
+    FloatImage image(const std::string& pass, const std::string& name) {
+        const TextureRef& t = tex(pass, name);
+        return readTexture(t.id, t.target, t.format, t.width, t.height);
+    }
+    void checkNoErrors() {
+        for (auto& e : app.runtime().activeErrors()) FAIL(e);
+    }
+};
+
+inline std::string pipeline(const std::string& output, const std::string& passes) {
+    return R"({"output": ")" + output + R"(", "passes": [)" + passes + "]}";
+}
+
+}  // namespace kiln::test
