@@ -8,6 +8,8 @@ packages=(
   python3-glad                       # glad 2: generates the GL loader at configure time
   libglfw3-dev libimgui-dev          # window + debug view
   libglm-dev nlohmann-json3-dev libstb-dev catch2
+  libtinyexr-dev                     # OpenEXR read/write for HDR textures (--dump, reference cache)
+  openimageio-tools                  # idiff/oiiotool: the error metrics are cross-checked against them
   libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri libglx-mesa0   # EGL/GL + llvmpipe
   xvfb xauth mesa-utils              # window tests/screenshots without a display
   inotify-tools                      # used by live-reload test scripts

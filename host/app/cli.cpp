@@ -17,7 +17,7 @@ usage: kiln [options]
   --size WxH        output size (default 720x720)
   --frames N        frames to render in headless mode (default 1)
   --out FILE.png    write the final image (headless)
-  --dump DIR        write every texture of the last frame (PNG, and PFM for float/depth)
+  --dump DIR        write every texture of the last frame (PNG, and OpenEXR for float/depth)
   --stats           print the per-pass time table (GPU timer queries + CPU clock)
   --no-live         do not watch files for live reloading
   --no-skip         run every pass every frame, even when nothing it reads changed

@@ -2,11 +2,13 @@
 
 #include <stb_image.h>
 #include <stb_image_write.h>
+#include <tinyexr.h>
 
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 
 namespace kiln {
@@ -70,23 +72,39 @@ bool writePng(const std::string& path, const FloatImage& img, int channels, std:
     return true;
 }
 
-bool writePfm(const std::string& path, const FloatImage& img, std::string& error) {
-    FILE* f = std::fopen(path.c_str(), "wb");
-    if (!f) {
-        error = path + ": cannot write: " + std::strerror(errno);
+bool writeExr(const std::string& path, const FloatImage& img, std::string& error) {
+    const int channels = img.channels >= 4 ? 4 : 3;
+    std::vector<float> data(static_cast<size_t>(img.width) * img.height * channels);
+    for (int y = 0; y < img.height; ++y)
+        for (int x = 0; x < img.width; ++x)
+            for (int c = 0; c < channels; ++c)
+                data[(static_cast<size_t>(img.height - 1 - y) * img.width + x) * channels + c] =
+                    c < img.channels ? img.at(x, y)[c] : 0.0f;
+    const char* message = nullptr;
+    if (SaveEXR(data.data(), img.width, img.height, channels, 0, path.c_str(), &message) < 0) {
+        error = path + ": cannot write EXR: " + (message ? message : std::strerror(errno));
+        if (message) FreeEXRErrorMessage(message);
         return false;
     }
-    // PFM: bottom-to-top rows, negative scale = little endian. RGB only.
-    std::fprintf(f, "PF\n%d %d\n-1.0\n", img.width, img.height);
-    std::vector<float> row(static_cast<size_t>(img.width) * 3);
-    for (int y = 0; y < img.height; ++y) {
-        for (int x = 0; x < img.width; ++x)
-            for (int c = 0; c < 3; ++c) row[static_cast<size_t>(x) * 3 + c] = img.at(x, y)[c];
-        std::fwrite(row.data(), sizeof(float), row.size(), f);
+    return true;
+}
+
+bool readExr(const std::string& path, FloatImage& out, std::string& error) {
+    float* rgba = nullptr;
+    int w = 0, h = 0;
+    const char* message = nullptr;
+    if (LoadEXR(&rgba, &w, &h, path.c_str(), &message) < 0) {
+        error = path + ": cannot read EXR: " + (message ? message : "unknown error");
+        if (message) FreeEXRErrorMessage(message);
+        return false;
     }
-    const bool ok = std::fclose(f) == 0;
-    if (!ok) error = path + ": write failed";
-    return ok;
+    out.width = w, out.height = h, out.channels = 4;
+    out.pixels.resize(static_cast<size_t>(w) * h * 4);
+    for (int y = 0; y < h; ++y)
+        std::copy_n(rgba + static_cast<size_t>(h - 1 - y) * w * 4, static_cast<size_t>(w) * 4,
+                    out.pixels.begin() + static_cast<std::ptrdiff_t>(static_cast<size_t>(y) * w * 4));
+    std::free(rgba);
+    return true;
 }
 
 bool readPng(const std::string& path, FloatImage& out, std::string& error) {

@@ -173,7 +173,7 @@ bool dumpTextures(const std::vector<NamedTexture>& textures, const fs::path& dir
         FloatImage img = readTexture(r.id, r.target, r.format, r.width, r.height, 0, layer);
         const std::string base = (dir / (t.pass + "." + t.name)).string();
         if (!writePng(base + ".png", img, 4, error)) return false;
-        if (isFloatFormat(r.format) && !writePfm(base + ".pfm", img, error)) return false;
+        if (isFloatFormat(r.format) && !writeExr(base + ".exr", img, error)) return false;
     }
     return true;
 }

@@ -71,7 +71,7 @@ struct NamedTexture {
 };
 
 // Writes each texture into `dir` as PASS.NAME.png (clamped to [0,1]) and, for float
-// and depth formats, PASS.NAME.pfm with the raw values. 3D textures: the middle slice
+// and depth formats, PASS.NAME.exr with the raw values. 3D textures: the middle slice
 // of level 0.
 bool dumpTextures(const std::vector<NamedTexture>&, const std::filesystem::path& dir, std::string& error);
 

@@ -77,7 +77,7 @@ TEST_CASE("kiln --headless --out writes the final image", "[integration][cli]") 
     CHECK(right[2] > right[0] + 0.06f);
 }
 
-TEST_CASE("kiln --dump writes one PNG per texture, PFM for float and depth", "[integration][cli]") {
+TEST_CASE("kiln --dump writes one PNG per texture, OpenEXR for float and depth", "[integration][cli]") {
     const fs::path dir = fs::path(TEST_OUTPUT_DIR) / "dump";
     fs::remove_all(dir);
     Run r = runKiln("--headless --size 64x64 --paused --dump " + dir.string());
@@ -86,9 +86,9 @@ TEST_CASE("kiln --dump writes one PNG per texture, PFM for float and depth", "[i
     std::set<std::string> files;
     for (auto& e : fs::directory_iterator(dir)) files.insert(e.path().filename().string());
     const std::set<std::string> expected = {
-        "gbuffer.albedo.png", "gbuffer.normal.png", "gbuffer.normal.pfm", "gbuffer.emissive.png",
-        "gbuffer.emissive.pfm", "gbuffer.depth.png", "gbuffer.depth.pfm", "composite.color.png",
-        "composite.hdr.png", "composite.hdr.pfm"};
+        "gbuffer.albedo.png", "gbuffer.normal.png", "gbuffer.normal.exr", "gbuffer.emissive.png",
+        "gbuffer.emissive.exr", "gbuffer.depth.png", "gbuffer.depth.exr", "composite.color.png",
+        "composite.hdr.png", "composite.hdr.exr"};
     for (auto& f : expected) {
         INFO(f);
         CHECK(files.count(f) == 1);
