@@ -21,71 +21,20 @@
 #include "app/app.hpp"
 #include "app/context.hpp"
 #include "kiln/log.hpp"
+#include "support/bench_support.hpp"
 
 namespace fs = std::filesystem;
 using namespace kiln;
 using Json = nlohmann::json;
+using namespace kiln::bench;
 
 namespace {
-
-struct Override {
-    std::string pass, param, json;
-};
 
 struct Config {
     std::string pipeline;
     std::vector<Override> overrides;
     std::string label;
 };
-
-double median(std::vector<double> v) {
-    if (v.empty()) return -1.0;
-    std::sort(v.begin(), v.end());
-    return v[v.size() / 2];
-}
-
-bool parseOverride(const std::string& text, Override& out, std::string& error) {
-    auto dot = text.find('.'), eq = text.find('=');
-    if (dot == std::string::npos || eq == std::string::npos || dot > eq) {
-        error = "\"" + text + "\": expected PASS.PARAM=VALUE";
-        return false;
-    }
-    out = {text.substr(0, dot), text.substr(dot + 1, eq - dot - 1), text.substr(eq + 1)};
-    return true;
-}
-
-// Applies overrides to the pipeline's JSON text (the graph compiler validates them).
-bool applyOverrides(const std::string& text, const std::vector<Override>& overrides, std::string& out,
-                    std::string& error) {
-    Json root = Json::parse(text, nullptr, false);
-    if (root.is_discarded()) {
-        error = "pipeline is not valid JSON";
-        return false;
-    }
-    for (auto& o : overrides) {
-        bool found = false;
-        for (auto& pass : root["passes"])
-            if (pass.value("id", "") == o.pass) {
-                Json value = Json::parse(o.json, nullptr, false);
-                if (value.is_discarded()) value = o.json;  // a bare word: an enum choice
-                pass["params"][o.param] = value;
-                found = true;
-            }
-        if (!found) {
-            error = "no pass \"" + o.pass + "\" in the pipeline";
-            return false;
-        }
-    }
-    out = root.dump(2);
-    return true;
-}
-
-std::string slurp(const std::string& path) {
-    std::ifstream in(path);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
 
 struct Args {
     std::vector<std::string> pipelines;
