@@ -170,3 +170,29 @@ TEST_CASE("reference vs rasterizer: the lamp's direct light on a floor agrees (o
     CHECK(std::abs(meanR / meanT - 1.0) < 0.02);
     CHECK(rel < 0.05);
 }
+
+TEST_CASE("error pass: an image against itself is black; a darker one reads blue in signed mode",
+          "[gi][reference]") {
+    Rig rig(stillScene(), 16);
+    auto run = [&](const std::string& image, const std::string& mode) {
+        rig.load(pipeline("error.color", R"({"id": "reference", "module": "reference", "params": {"samples_per_frame": 4}},
+            {"id": "error", "module": "error", "inputs": {"image": ")" + image + R"(", "reference": "reference.radiance"},
+             "params": {"mode": ")" + mode + R"("}})"));
+        rig.app.frame();
+        rig.checkNoErrors();
+        return rig.image("error", "color");
+    };
+    const FloatImage same = run("reference.radiance", "relative");
+    for (float v : same.pixels) CHECK((v == 0.0f || v == 1.0f));  // rgb black, alpha 1
+    // direct ≤ total everywhere (the indirect part is ≥ 0): never red, and blue where
+    // the indirect light is (most of the room).
+    const FloatImage darker = run("reference.direct", "signed");
+    int blue = 0;
+    for (int y = 0; y < darker.height; ++y)
+        for (int x = 0; x < darker.width; ++x) {
+            const float* p = darker.at(x, y);
+            CHECK(p[0] <= p[2] + 1e-6f);
+            blue += p[2] > 0.99f && p[0] < 0.95f;
+        }
+    CHECK(blue > darker.width * darker.height / 4);
+}
