@@ -102,8 +102,8 @@ bool writeLogLogPng(const std::string& path, const LogLogPlot& plot, std::string
         for (auto& [x, y] : s.points) {
             if (!(x > 0 && y > 0 && std::isfinite(x) && std::isfinite(y))) continue;
             const double X = px(std::log10(x)), Y = py(std::log10(y));
-            if (have) c.line(ox, oy, X, Y, s.color, 2);
-            c.rect(int(X) - 3, int(Y) - 3, int(X) + 3, int(Y) + 3, s.color);
+            if (have && s.connect) c.line(ox, oy, X, Y, s.color, 2);
+            c.rect(int(X) - s.marker, int(Y) - s.marker, int(X) + s.marker, int(Y) + s.marker, s.color);
             ox = X, oy = Y, have = true;
         }
         const int lx = legendLeft ? left + 16 : right - 16 - c.textWidth(s.label) - 30;

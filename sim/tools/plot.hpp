@@ -12,6 +12,8 @@ struct PlotSeries {
     std::string label;
     std::array<uint8_t, 3> color{0, 0, 0};
     std::vector<std::pair<double, double>> points;  // (x, y), both > 0; others skipped
+    bool connect = true;                            // false: markers only (a scatter)
+    int marker = 3;                                 // half-size of the square marker, px
 };
 
 struct LogLogPlot {
