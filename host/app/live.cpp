@@ -5,6 +5,7 @@
 
 #include "app/app.hpp"
 #include "kiln/log.hpp"
+#include "kiln/module_loader.hpp"
 
 namespace fs = std::filesystem;
 
@@ -33,14 +34,95 @@ void LiveReload::start(App& app) {
     watcher_->watch(canonical(app.scene().file()).parent_path());
 }
 
+namespace {
+bool statFile(const fs::path& p, uintmax_t& size, fs::file_time_type& mtime) {
+    std::error_code ec;
+    size = fs::file_size(p, ec);
+    if (ec) return false;
+    mtime = fs::last_write_time(p, ec);
+    return !ec;
+}
+}  // namespace
+
+void LiveReload::reloadModule(App& app, const std::string& module, const fs::path& path) {
+    Runtime& rt = app.runtime();
+    const auto t0 = Clock::now();
+    std::string error;
+    if (rt.reloadModule(module, error)) {
+        pendingModules_.erase(module);
+        rt.setExternalError("module:" + module, "");
+        log::info("reloaded module ", module, " in ", msSince(t0), " ms");
+        ++moduleReloads;
+        return;
+    }
+    std::string why;
+    auto pending = pendingModules_.find(module);
+    const bool withinWindow = pending == pendingModules_.end() || t0 - pending->second.firstFailure < kModuleRetryWindow;
+    if (!ModuleLoader::checkFile(path, why) && withinWindow) {
+        // Perhaps still being written: not loaded, not yet reported as broken.
+        if (pending == pendingModules_.end()) {
+            PendingModule p;
+            p.path = path;
+            p.firstFailure = t0;
+            pending = pendingModules_.emplace(module, std::move(p)).first;
+        }
+        PendingModule& p = pending->second;
+        p.error = error;
+        p.stableSince = t0;
+        p.triedThisVersion = true;
+        statFile(path, p.size, p.mtime);
+        rt.setExternalError("module:" + module, error + " (waiting for the file to be complete, retrying; "
+                                                         "the previous module keeps running)");
+        log::info("module ", module, " does not load yet (", why, "): retrying when the file settles");
+        return;
+    }
+    pendingModules_.erase(module);
+    rt.setExternalError("module:" + module, error + " (the previous module keeps running)");
+    log::error(error);
+    ++failures;
+}
+
+int LiveReload::retryModules(App& app) {
+    const int before = moduleReloads;
+    const auto now = Clock::now();
+    std::vector<std::string> names;
+    for (auto& [name, p] : pendingModules_) names.push_back(name);
+    for (const std::string& name : names) {
+        auto it = pendingModules_.find(name);
+        if (it == pendingModules_.end()) continue;
+        PendingModule& p = it->second;
+        uintmax_t size = 0;
+        fs::file_time_type mtime{};
+        const bool exists = statFile(p.path, size, mtime);
+        if (exists && (size != p.size || mtime != p.mtime)) {  // still growing: wait
+            p.size = size, p.mtime = mtime, p.stableSince = now, p.triedThisVersion = false;
+            continue;
+        }
+        if (now - p.firstFailure >= kModuleRetryWindow) {
+            // Still invalid after the window: a broken module, reported once.
+            const std::string error = p.error + " (still invalid " +
+                                      std::to_string(kModuleRetryWindow.count() / 1000) +
+                                      " s after it changed; the previous module keeps running)";
+            app.runtime().setExternalError("module:" + name, error);
+            log::error(p.error);
+            ++failures;
+            pendingModules_.erase(it);
+            continue;
+        }
+        if (exists && !p.triedThisVersion && now - p.stableSince >= kModuleSettle) reloadModule(app, name, p.path);
+    }
+    return moduleReloads - before;
+}
+
 int LiveReload::poll(App& app) {
     if (!watcher_) return 0;
+    const int retried = pendingModules_.empty() ? 0 : retryModules(app);
     auto changed = watcher_->poll();
-    if (changed.empty()) return 0;
+    if (changed.empty()) return retried;
     Runtime& rt = app.runtime();
     const fs::path pipeline = canonical(rt.pipelineFile()), scene = canonical(app.scene().file());
     std::vector<fs::path> shaders;
-    int reloads = 0;
+    int reloads = retried;
     for (auto& path : changed) {
         const auto t0 = std::chrono::steady_clock::now();
         const std::string name = path.filename().string();
@@ -70,16 +152,9 @@ int LiveReload::poll(App& app) {
         } else if (name.rfind("libpass_", 0) == 0 && path.extension() == ".so") {
             const std::string module = name.substr(8, name.size() - 11);
             if (!rt.usesModule(module)) continue;
-            std::string error;
-            if (rt.reloadModule(module, error)) {
-                rt.setExternalError("module:" + module, "");
-                log::info("reloaded module ", module, " in ", msSince(t0), " ms");
-                ++moduleReloads, ++reloads;
-            } else {
-                rt.setExternalError("module:" + module, error + " (the previous module keeps running)");
-                log::error(error);
-                ++failures;
-            }
+            const int before = moduleReloads;
+            reloadModule(app, module, path);
+            reloads += moduleReloads - before;
         } else if (isShader(path)) {
             shaders.push_back(path);
         }

@@ -107,6 +107,8 @@ bool checkElf(const fs::path& file, std::string& error) {
 }
 }  // namespace
 
+bool ModuleLoader::checkFile(const fs::path& file, std::string& why) { return checkElf(file, why); }
+
 std::shared_ptr<LoadedModule> ModuleLoader::load(const std::string& name, std::string& error) {
     if (!isValidName(name)) {
         error = "module name \"" + name + "\" is not valid: a module is named by " + std::string(kNameRule) + ", no path, \"..\" or suffix";

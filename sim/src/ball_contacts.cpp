@@ -215,12 +215,14 @@ bool World::separateBallsFromTumblers() {
 
 void World::collideBallPairs() {
     const int n = int(balls_.size());
+    pairChecks_ = 0;
     if (n < 2) return;
     if (n <= 32) {
         // Few balls: every pair in index order is cheaper than clearing and counting a
         // grid of up to 64³ cells (and just as deterministic).
         for (int i = 0; i < n; ++i)
             for (int j = i + 1; j < n; ++j) resolveBallBallContact(i, j);
+        pairChecks_ = uint64_t(n) * uint64_t(n - 1) / 2;
         return;
     }
     // Uniform grid over the box, cell ≥ the largest diameter: a ball can only touch
@@ -247,6 +249,7 @@ void World::collideBallPairs() {
     for (int i = 0; i < n; ++i) {
         const int c = gridCells_[size_t(i)];
         const int cx = c / (dim * dim), cy = (c / dim) % dim, cz = c % dim;
+        pairChecks_ += uint64_t(gridStart_[size_t(c) + 1] - gridStart_[size_t(c)]);
         for (int k = gridStart_[size_t(c)]; k < gridStart_[size_t(c) + 1]; ++k) {
             const int j = gridOrder_[size_t(k)];
             if (j > i) resolveBallBallContact(i, j);
@@ -257,6 +260,7 @@ void World::collideBallPairs() {
                     const int x = cx + dx, y = cy + dy, z = cz + dz;
                     if (x >= dim || y < 0 || y >= dim || z < 0 || z >= dim) continue;
                     const int cell = (x * dim + y) * dim + z;
+                    pairChecks_ += uint64_t(gridStart_[size_t(cell) + 1] - gridStart_[size_t(cell)]);
                     for (int k = gridStart_[size_t(cell)]; k < gridStart_[size_t(cell) + 1]; ++k)
                         resolveBallBallContact(i, gridOrder_[size_t(k)]);
                 }

@@ -1,6 +1,7 @@
 #include "kiln/sim/scene.hpp"
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -18,6 +19,16 @@ std::string SceneError::toString(const std::string& file) const {
 }
 
 namespace {
+
+// A message quotes at most this much of a value: a 10 MB array as a "radius" gives a
+// one-line error, not a 10 MB one.
+std::string elide(const std::string& s, size_t max = 60) {
+    if (s.size() <= max) return s;
+    return s.substr(0, max - 3) + "...";
+}
+// The value as the file wrote it, elided (nesting is bounded before anything is parsed,
+// so dump() cannot recurse deeply).
+std::string shown(const Json& v) { return elide(v.dump()); }
 
 const char* typeName(const Json& j) {
     switch (j.type()) {
@@ -53,7 +64,7 @@ struct Reader {
         if (!v.is_number()) return fail(at(key), std::string("expected a number, got ") + typeName(v));
         double d = v.get<double>();
         if (!std::isfinite(d) || d < lo || d > hi)
-            return fail(at(key), "must be within [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " + v.dump());
+            return fail(at(key), "must be within [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " + shown(v));
         out = d;
         return true;
     }
@@ -61,10 +72,10 @@ struct Reader {
         known.insert(key);
         if (!j.contains(key)) return true;
         const Json& v = j[key];
-        if (!v.is_number_integer()) return fail(at(key), std::string("expected an integer, got ") + v.dump());
+        if (!v.is_number_integer()) return fail(at(key), std::string("expected an integer, got ") + shown(v));
         long long n = v.get<long long>();
         if (n < lo || n > hi)
-            return fail(at(key), "must be within [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " + v.dump());
+            return fail(at(key), "must be within [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " + shown(v));
         out = int(n);
         return true;
     }
@@ -74,14 +85,14 @@ struct Reader {
         if (!j.contains(key)) return true;
         const Json& v = j[key];
         if (!v.is_array() || v.size() != N)
-            return fail(at(key), "expected an array of " + std::to_string(N) + " numbers, got " + v.dump());
+            return fail(at(key), "expected an array of " + std::to_string(N) + " numbers, got " + shown(v));
         for (int i = 0; i < N; ++i) {
             if (!v[size_t(i)].is_number())
                 return fail(at(key) + "[" + std::to_string(i) + "]", std::string("expected a number, got ") + typeName(v[size_t(i)]));
             double d = v[size_t(i)].get<double>();
             if (!std::isfinite(d) || d < lo || d > hi)
                 return fail(at(key) + "[" + std::to_string(i) + "]",
-                            "must be within [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " + v[size_t(i)].dump());
+                            "must be within [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " + shown(v[size_t(i)]));
             out[i] = d;
         }
         return true;
@@ -92,13 +103,13 @@ struct Reader {
         const Json& v = j[key];
         std::string list;
         for (auto& c : choices) list += (list.empty() ? "" : ", ") + ("\"" + c + "\"");
-        if (!v.is_string()) return fail(at(key), "expected one of " + list + ", got " + v.dump());
+        if (!v.is_string()) return fail(at(key), "expected one of " + list + ", got " + shown(v));
         for (size_t i = 0; i < choices.size(); ++i)
             if (v.get<std::string>() == choices[i]) {
                 out = int(i);
                 return true;
             }
-        return fail(at(key), "expected one of " + list + ", got " + v.dump());
+        return fail(at(key), "expected one of " + list + ", got " + shown(v));
     }
     bool boolean(const std::string& key, bool& out) {
         known.insert(key);
@@ -113,7 +124,7 @@ struct Reader {
         known.insert("note");
         known.insert("$schema");
         for (auto& [k, v] : j.items())
-            if (!known.count(k)) return fail(at(k), "unknown key");
+            if (!known.count(k)) return fail(at(elide(k)), "unknown key");
         return true;
     }
 };
@@ -175,22 +186,116 @@ bool restitution(const Json& physics, Scene::Physics::Restitution& e, SceneError
            r.finish();
 }
 
-// Parses the JSON text; a syntax error becomes "line L, column C: ...".
+void lineColumn(const std::string& text, size_t offset, int& line, int& column) {
+    line = 1, column = 1;
+    offset = std::min(offset, text.size());
+    for (size_t i = 0; i < offset; ++i) {
+        if (text[i] == '\n') ++line, column = 1;
+        else ++column;
+    }
+}
+
+// The first bracket that opens level kMaxSceneNesting + 1 (strings skipped), or npos.
+// Checked before parsing: nothing ever holds (copies, dumps, destroys) a deeper value.
+size_t tooDeep(const std::string& text) {
+    int depth = 0;
+    bool inString = false;
+    for (size_t i = 0; i < text.size(); ++i) {
+        const char c = text[i];
+        if (inString) {
+            if (c == '\\') ++i;
+            else if (c == '"') inString = false;
+        } else if (c == '"') {
+            inString = true;
+        } else if (c == '[' || c == '{') {
+            if (++depth > kMaxSceneNesting) return i;
+        } else if (c == ']' || c == '}') {
+            --depth;
+        }
+    }
+    return std::string::npos;
+}
+
+// Follows the parse to know the JSON path of the value being read when the library
+// refuses one (a number beyond double range): "physics.dt", "marbles[3].position[1]".
+class PathTracker {
+public:
+    bool operator()(int /*depth*/, nlohmann::detail::parse_event_t event, Json& parsed) {
+        using E = nlohmann::detail::parse_event_t;
+        switch (event) {
+            case E::object_start: frames_.push_back({false, 0, {}}); break;
+            case E::array_start: frames_.push_back({true, 0, {}}); break;
+            case E::key: if (!frames_.empty()) frames_.back().key = parsed.is_string() ? parsed.get<std::string>() : ""; break;
+            case E::object_end:
+            case E::array_end:
+                if (!frames_.empty()) frames_.pop_back();
+                finishValue();
+                break;
+            case E::value: finishValue(); break;
+        }
+        return true;
+    }
+    std::string path() const {
+        std::string p;
+        for (const Frame& f : frames_)
+            p = f.array ? p + "[" + std::to_string(f.index) + "]" : (p.empty() ? elide(f.key) : p + "." + elide(f.key));
+        return p;
+    }
+
+private:
+    struct Frame {
+        bool array;
+        size_t index;
+        std::string key;
+    };
+    void finishValue() {
+        if (!frames_.empty() && frames_.back().array) ++frames_.back().index;
+    }
+    std::vector<Frame> frames_;
+};
+
+// Parses the JSON text; a syntax error becomes "line L, column C: ...". Every exception
+// the JSON library throws (syntax, a number beyond double range, ...) becomes an error
+// here: none escapes to the caller.
 bool parseJson(const std::string& text, Json& root, SceneError& error) {
+    int line = 1, column = 1;
+    if (const size_t at = tooDeep(text); at != std::string::npos) {
+        lineColumn(text, at, line, column);
+        error = {"", "line " + std::to_string(line) + ", column " + std::to_string(column) + ": nested deeper than " +
+                         std::to_string(kMaxSceneNesting) + " levels"};
+        return false;
+    }
+    PathTracker tracker;
     try {
-        root = Json::parse(text);
+        root = Json::parse(text, std::ref(tracker));
     } catch (const Json::parse_error& e) {
         // Byte offset → line and column.
-        size_t offset = std::min<size_t>(e.byte > 0 ? e.byte - 1 : 0, text.size());
-        int line = 1, column = 1;
-        for (size_t i = 0; i < offset; ++i) {
-            if (text[i] == '\n') ++line, column = 1;
-            else ++column;
-        }
+        lineColumn(text, e.byte > 0 ? e.byte - 1 : 0, line, column);
+        // what(): "[json.exception.parse_error.101] parse error at line 1, column 5: syntax
+        // error while parsing ...; last read: '...'": the part after the position (the
+        // quoted token may itself hold ": ").
         std::string what = e.what();
-        auto colon = what.rfind(": ");
+        const size_t p = what.find("parse error");
+        const size_t colon = p == std::string::npos ? std::string::npos : what.find(": ", p);
         error = {"", "line " + std::to_string(line) + ", column " + std::to_string(column) + ": " +
-                         (colon == std::string::npos ? what : what.substr(colon + 2))};
+                         elide(colon == std::string::npos ? what : what.substr(colon + 2), 160)};
+        return false;
+    } catch (const Json::exception& e) {
+        // out_of_range 406 "number overflow parsing '1e999'": locate the quoted token.
+        std::string what = e.what();
+        const size_t bracket = what.find("] ");
+        if (bracket != std::string::npos) what = what.substr(bracket + 2);
+        std::string where;
+        const size_t open = what.find('\''), close = what.rfind('\'');
+        if (open != std::string::npos && close > open + 1) {
+            const size_t at = text.find(what.substr(open + 1, close - open - 1));
+            if (at != std::string::npos) {
+                lineColumn(text, at, line, column);
+                where = "line " + std::to_string(line) + ", column " + std::to_string(column) + ": ";
+            }
+        }
+        if (e.id == 406) what += " (beyond the range of a double)";
+        error = {tracker.path(), where + elide(what, 160)};
         return false;
     }
     if (!root.is_object()) {
@@ -198,6 +303,13 @@ bool parseJson(const std::string& text, Json& root, SceneError& error) {
         return false;
     }
     return true;
+}
+
+// A list longer than its limit is refused before any entry is read.
+bool withinLimit(const Json& root, const char* key, size_t limit, const char* what, SceneError& error) {
+    if (!root.contains(key) || !root[key].is_array() || root[key].size() <= limit) return true;
+    error = {key, std::to_string(root[key].size()) + " " + what + ", more than the limit of " + std::to_string(limit)};
+    return false;
 }
 
 bool readBox(const Json& root, Scene& s, SceneError& error) {
@@ -336,10 +448,25 @@ bool checkTumblerPoses(const Scene& s, SceneError& error) {
 
 }  // namespace
 
+static bool readScene(const Json& root, Scene& out, SceneError& error);
+
 bool parseScene(const std::string& text, Scene& out, SceneError& error) {
     Json root;
     if (!parseJson(text, root, error)) return false;
+    try {
+        return readScene(root, out, error);
+    } catch (const std::exception& e) {  // no library exception crosses the loader
+        error = {"", std::string("cannot read the scene: ") + elide(e.what(), 160)};
+        return false;
+    }
+}
+
+static bool readScene(const Json& root, Scene& out, SceneError& error) {
     Scene s;
+    if (!withinLimit(root, "tumblers", kMaxTumblers, "tumblers", error) ||
+        !withinLimit(root, "marbles", kMaxMarbles, "marbles", error) ||
+        !withinLimit(root, "fireballs", kMaxFireballs, "fireballs", error))
+        return false;
     if (!readBox(root, s, error) || !readLamp(root, s, error) || !readPhysics(root, s, error) ||
         !readShape(root, s, error) || !readTumblers(root, s, error) || !checkTumblerPoses(s, error))
         return false;
@@ -358,9 +485,20 @@ SceneResult parseSceneText(const std::string& text) {
 }
 
 SceneResult loadSceneFile(const std::string& path) {
+    SceneResult r;
+    std::error_code ec;
+    if (std::filesystem::is_directory(path, ec)) {
+        r.error = {"", "is a directory, not a scene file"};
+        return r;
+    }
+    const auto size = std::filesystem::file_size(path, ec);
+    if (!ec && size > kMaxSceneFileBytes) {
+        r.error = {"", "the file is " + std::to_string(size) + " bytes, more than the limit of " +
+                           std::to_string(kMaxSceneFileBytes)};
+        return r;
+    }
     std::ifstream in(path, std::ios::binary);
     if (!in) {
-        SceneResult r;
         r.error = {"", "cannot read the scene file"};
         return r;
     }

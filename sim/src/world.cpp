@@ -8,6 +8,7 @@ using namespace detail;
 
 void World::reset(const Scene& scene) {
     scene_ = scene;
+    pairChecks_ = kPairChecksUnknown;
     const auto& ts = scene.tumblerShape;
     shape_ = RoundCone(ts.b, ts.t, ts.alpha);
     mass_ = shape_.massProperties(ts.mass);
@@ -161,7 +162,18 @@ int World::substepsFor(double frame) const {
         need = std::max(need, speed * frame / (0.5 * b.radius));
     }
     const int n = std::max(1, scene_.physics.substeps);
-    return std::clamp(int(std::ceil(std::min(need, 1e6))), n, std::max(n, scene_.physics.maxSubsteps));
+    const int wanted = std::clamp(int(std::ceil(std::min(need, 1e6))), n, std::max(n, scene_.physics.maxSubsteps));
+    // Bounded work per step, whatever the scene asks: sub-steps × (ball-tumbler pairs +
+    // ball pairs the broad phase looked at last + tumbler pairs) stays within
+    // kWorkPerStep (~40-80 ms here). A crowded scene at the count limits (scene.hpp) with
+    // fast balls gets fewer sub-steps, not a frozen frame; the shipped scene (~100 units
+    // a sub-step) never comes near it.
+    constexpr double kWorkPerStep = double(1 << 22);
+    const double balls = double(balls_.size()), tumblers = double(tumblers_.size());
+    // Before the first broad phase its cost is unknown: assume every pair.
+    const double pairs = pairChecks_ == kPairChecksUnknown ? balls * (balls - 1.0) / 2.0 : double(pairChecks_);
+    const double perSubstep = balls * (tumblers + 1.0) + tumblers * tumblers + pairs + 1.0;
+    return std::min(wanted, std::max(1, int(kWorkPerStep / perSubstep)));
 }
 
 void World::step() {
@@ -233,6 +245,9 @@ void World::spawnFireball(const Vec3& position, const Vec3& velocity, double rad
 }
 
 void World::spawnRandom(BallKind kind) {
+    // A held key spawns every frame: the count stays within what a scene file may ask
+    // for, so a step stays bounded (scene.hpp's limits).
+    if (balls_.size() >= kMaxMarbles + kMaxFireballs) return;
     Vec3 p;  // one draw per statement: argument evaluation order is unspecified
     p.x = rng_.uniform(-0.7, 0.7);
     p.y = rng_.uniform(0.0, 0.6);

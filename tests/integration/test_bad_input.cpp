@@ -100,6 +100,30 @@ TEST_CASE("bad pipeline files", "[integration][robust]") {
     for (auto& c : cases) check(c);
 }
 
+TEST_CASE("bad scene files", "[integration][robust]") {
+    auto scene = [](const std::string& file, const std::string& text) {
+        return [file, text](const fs::path& d) { write(d / file, text); return "--scene " + (d / file).string(); };
+    };
+    std::string many = "{\"tumblers\": [], \"marbles\": [";
+    for (int i = 0; i < 100000; ++i) many += (i ? "," : "") + std::string("{\"position\": [0, 0, 0]}");
+    many += "]}";
+    const std::vector<Case> cases = {
+        {"scene-missing", [](const fs::path& d) { return "--scene " + (d / "none.json").string(); },
+         "none.json: cannot read the scene file"},
+        {"scene-directory", [](const fs::path& d) { return "--scene " + d.string(); }, "is a directory, not a scene file"},
+        {"scene-garbage", scene("g.json", garbage(4096)), "g.json: line 1, column 1: syntax error"},
+        {"scene-overflow", scene("o.json", R"({"tumblers": [], "physics": {"dt": 1e999}})"),
+         "o.json: physics.dt: line 1, column 36: number overflow parsing '1e999'"},
+        {"scene-overflow-8-bytes", scene("p.json", "[22E444"), "p.json: [0]: line 1, column 2: number overflow"},
+        {"scene-deep", scene("n.json", "{\"note\": " + std::string(100000, '[') + std::string(100000, ']') + "}"),
+         "n.json: line 1, column 41: nested deeper than 32 levels"},
+        {"scene-long-value", scene("l.json", R"({"tumblers": [], "physics": {"tumbler_mode": ")" + std::string(100000, 'x') + "\"}}"),
+         "l.json: physics.tumbler_mode: expected one of"},
+        {"scene-many-marbles", scene("m.json", many), "m.json: marbles: 100000 marbles, more than the limit of 1024"},
+    };
+    for (auto& c : cases) check(c);
+}
+
 TEST_CASE("bad shader roots", "[integration][robust]") {
     const std::vector<Case> cases = {
         {"shaders-missing", [](const fs::path& d) { return "--shaders " + (d / "none").string(); },

@@ -176,6 +176,53 @@ TEST_CASE("a rebuilt module is swapped in with its parameters kept, a broken one
     CHECK(near(box.centre(), {0.0f, 0.25f, 1.0f}));  // the previous module keeps running
 }
 
+TEST_CASE("a module written in two halves is retried, not reported broken, and one left truncated is", "[live][gl]") {
+    const std::string pipeline = R"({"output": "tint.color",
+        "passes": [{"id": "tint", "module": "live_tint", "params": {"level": 0.25}}]})";
+    const fs::path v1 = fs::path(LIVE_MODULE_BUILDS) / "tint_v1.so", v2 = fs::path(LIVE_MODULE_BUILDS) / "tint_v2.so";
+    Sandbox box("module-midwrite", "tint.json", pipeline,
+                [&](const fs::path& root) { fs::copy_file(v1, root / "modules/libpass_live_tint.so"); });
+    REQUIRE(box.waitFor([&] { return near(box.centre(), {1.0f, 0.25f, 0.0f}); }));
+    const fs::path installed = box.root / "modules/libpass_live_tint.so";
+    const std::string full = slurp(v2);
+    const int failures = box.app.live().failures;
+
+    // The first half (what an interrupted build or a chunked copy leaves for a moment).
+    writeInPlace(installed, full.substr(0, full.size() / 2));
+    REQUIRE(box.waitFor([&] { return box.app.live().pendingModules() == 1; }));
+    CHECK(box.errorMentions("retrying"));
+    CHECK(box.app.live().failures == failures);        // not reported as broken
+    CHECK(near(box.centre(), {1.0f, 0.25f, 0.0f}));    // the old module keeps running
+    // The rest: swapped in, nothing reported.
+    writeInPlace(installed, full);
+    CHECK(box.waitFor([&] { return near(box.centre(), {0.0f, 0.25f, 1.0f}); }));
+    CHECK(box.app.live().failures == failures);
+    CHECK(box.app.live().pendingModules() == 0);
+    CHECK_FALSE(box.errorMentions("libpass_live_tint.so"));
+
+    // Left truncated: after the retry window it is a named error, once.
+    writeInPlace(installed, full.substr(0, 4096));
+    CHECK(box.waitFor([&] { return box.errorMentions("still invalid"); }));
+    CHECK(box.errorMentions("libpass_live_tint.so"));
+    CHECK(box.app.live().failures == failures + 1);
+    CHECK(box.app.live().pendingModules() == 0);
+    box.app.camera().yaw += 0.1f;
+    CHECK(near(box.centre(), {0.0f, 0.25f, 1.0f}));  // the previous module keeps running
+}
+
+TEST_CASE("a scene with a number beyond double range keeps the running world", "[live][gl]") {
+    Sandbox box("scene-overflow");
+    const fs::path scene = box.root / "scenes/cornell.json";
+    REQUIRE(box.app.scene().sim().tumblers().size() == 5);
+    writeByRename(scene, R"({"tumblers": [{"position": [0.0, 0.0]}], "physics": {"dt": 1e999}})");
+    CHECK(box.waitFor([&] { return box.errorMentions("physics.dt"); }));
+    CHECK(box.errorMentions("number overflow"));
+    CHECK(box.app.scene().sim().tumblers().size() == 5);
+    writeByRename(scene, "{\"tumblers\": [], \"note\": " + std::string(100000, '[') + std::string(100000, ']') + "}");
+    CHECK(box.waitFor([&] { return box.errorMentions("nested deeper than 32 levels"); }));
+    CHECK(box.app.scene().sim().tumblers().size() == 5);
+}
+
 TEST_CASE("a scene edit resets the world, an invalid scene keeps it", "[live][gl]") {
     Sandbox box("scene-edit");
     const fs::path scene = box.root / "scenes/cornell.json";

@@ -60,6 +60,10 @@ public:
 
     const std::vector<std::filesystem::path>& dirs() const { return dirs_; }
 
+    // The ELF check load() runs before dlopen: false (with `why`) for a file that is not
+    // a complete 64-bit ELF shared library — garbage, or one still being written.
+    static bool checkFile(const std::filesystem::path& file, std::string& why);
+
 private:
     std::vector<std::filesystem::path> dirs_;
     std::filesystem::path scratch_;  // private copies of loaded libraries

@@ -48,10 +48,16 @@
 // t < b, every tumbler (both spheres, with its tilt) inside the box, tumblers not
 // overlapping each other, every ball inside the box.
 //
+// Limits (each a named error with the limit in it): at most kMaxTumblers tumblers,
+// kMaxMarbles marbles, kMaxFireballs fireballs; nesting at most kMaxSceneNesting deep;
+// a file of at most kMaxSceneFileBytes. A number beyond double range (1e999) is an error
+// at its JSON path. Messages quote values elided to a few dozen characters.
+//
 // Errors carry the JSON path (`tumblers[2].position`, `physics.dt`, `marbles[0].radius`)
 // and what is wrong; a syntax error carries "line L, column C: ..." and an empty path.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -59,6 +65,14 @@
 #include <glm/glm.hpp>
 
 namespace kiln::sim {
+
+// Bounds on what a scene may ask for: every step stays bounded (the ball broad phase is
+// at worst quadratic in the balls sharing a grid cell, ~ (kMaxMarbles + kMaxFireballs)²).
+inline constexpr size_t kMaxTumblers = 64;
+inline constexpr size_t kMaxMarbles = 1024;
+inline constexpr size_t kMaxFireballs = 64;
+inline constexpr int kMaxSceneNesting = 32;  // as the pipeline loader
+inline constexpr size_t kMaxSceneFileBytes = size_t(16) << 20;
 
 struct SceneError {
     std::string path;     // JSON path, e.g. "tumblers[2].position"; empty for syntax errors

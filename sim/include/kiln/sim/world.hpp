@@ -151,7 +151,8 @@ public:
     void spawnMarble(const Vec3& position, const Vec3& velocity, double radius = 0.05);
     void spawnFireball(const Vec3& position, const Vec3& velocity, double radius = 0.06);
     // Spawns at a random spot (x, z ∈ [−0.7, 0.7], y ∈ [0, 0.6]) with a random velocity
-    // of 1–3 m/s, drawn from the world's seeded generator (keyboard shortcuts).
+    // of 1–3 m/s, drawn from the world's seeded generator (keyboard shortcuts); nothing
+    // once there are kMaxMarbles + kMaxFireballs balls.
     void spawnRandom(BallKind kind);
 
     // Signed distance from a world point to tumbler i, and the outward normal there.
@@ -268,6 +269,9 @@ private:
     uint64_t bodiesVersion_ = 0, particlesVersion_ = 0;
     bool bodiesMoved_ = false, particlesChanged_ = false;
     std::vector<int> gridCells_, gridStart_, gridCursor_, gridOrder_;  // broad phase scratch (ball pairs)
+    // Ball pairs the last broad phase looked at (the step's work budget, substepsFor).
+    static constexpr uint64_t kPairChecksUnknown = ~uint64_t(0);
+    uint64_t pairChecks_ = kPairChecksUnknown;
     std::vector<Vec3> ballsBefore_;  // ball positions at the start of the sub-step (swept tests)
 
     struct Drag {
