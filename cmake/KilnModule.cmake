@@ -21,7 +21,7 @@ function(kiln_add_module target)
   set_target_properties(${target} PROPERTIES
     PREFIX "" OUTPUT_NAME "${MOD_FILE}" LIBRARY_OUTPUT_DIRECTORY "${MOD_DIRECTORY}"
     CXX_VISIBILITY_PRESET hidden VISIBILITY_INLINES_HIDDEN ON)
-  target_compile_options(${target} PRIVATE -fno-gnu-unique)
+  target_compile_options(${target} PRIVATE $<$<CXX_COMPILER_ID:GNU>:-fno-gnu-unique>)
   target_link_options(${target} PRIVATE -Wl,--no-undefined)
 endfunction()
 

@@ -325,7 +325,7 @@ private:
         for (const auto& [name, literal] : p.params) {
             const std::string path = passPath(i) + ".params." + name;
             auto d = std::find_if(decl->params.begin(), decl->params.end(),
-                                  [&](const ParamDecl& pd) { return pd.name == name; });
+                                  [&n = name](const ParamDecl& pd) { return pd.name == n; });
             if (d == decl->params.end()) {
                 passError(i, path, "module " + q(p.module) + " has no parameter " + q(name) +
                                        suggestion(name, names, "parameters"));

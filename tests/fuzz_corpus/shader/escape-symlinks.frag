@@ -1,0 +1,6 @@
+#version 450
+#include "escape.glsl"
+#include "escape_dir/inc.glsl"
+#include "../outside.glsl"
+#include "loop_a.glsl"
+void main() {}
