@@ -13,7 +13,10 @@ packages=(
   libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri libglx-mesa0   # EGL/GL + llvmpipe
   xvfb xauth mesa-utils              # window tests/screenshots without a display
   inotify-tools                      # used by live-reload test scripts
+  xdotool imagemagick                # driving the window in tests (keys, clicks, screenshots)
 )
+# scripts/fuzz.sh only: clang with libFuzzer (not needed to build, run or test).
+[ "${1:-}" = "--fuzz" ] && packages+=(clang-14 libclang-rt-14-dev)
 
 missing=()
 for p in "${packages[@]}"; do
