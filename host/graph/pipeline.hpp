@@ -28,6 +28,7 @@
 #include "kiln/declare.hpp"
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -77,6 +78,37 @@ Result<PipelineDesc> parsePipeline(const std::string& text, const std::string& f
 // Writes a pipeline back as pretty JSON (2-space indent, keys in the canonical
 // order; "enabled" only when false, empty params/inputs left out).
 std::string writePipeline(const PipelineDesc&);
+
+// Rewrites `original` (a pipeline file's text, which parses to some PipelineDesc) so that
+// it describes `edited`, touching only what differs — for the debug view's "write back",
+// where writePipeline() would reorder keys and reflow the whole file.
+//
+// Value edits, the only ones made:
+//   - a changed parameter value is replaced in place; the bytes around it are untouched.
+//     Values are written as writePipeline() writes them (compact JSON, floats in their
+//     shortest round-tripping form, flat arrays as [1.0, 0.5, 0.25]). A value that is the
+//     same is left as written: an int in the file that `edited` holds as the equal float
+//     (`1` vs 1.0; a float parameter accepts an int) stays `1`; the other way (2048.0 in
+//     the file, the int 2048 edited) is rewritten, since an int parameter refuses 2048.0.
+//   - a parameter the file lacks is appended to the pass's "params" object, copying the
+//     spacing and indentation of the object's last key (a one-line object stays one line);
+//     when the pass has no "params", `"params": { ... }` (one line) is added right after
+//     its "module" key, spaced like that key; an empty `{}` becomes `{ "name": value }`.
+//   - "enabled": a pass turned off that has no "enabled" key gets `"enabled": false` after
+//     its "module" key; an existing "enabled" value is replaced in place, so a pass turned
+//     back on keeps an explicit `"enabled": true` (not removed: removing a key means
+//     guessing which comma and whitespace go with it, and the explicit key shows where to
+//     toggle it again).
+// Anything else that differs is not a value edit — passes added, removed or reordered, a
+// pass's id, module, inputs (including their order) or note, the pipeline's output, note
+// or $schema, a parameter the file has but `edited` lacks, a parameter named twice in
+// `edited`, a value JSON cannot hold (NaN/Inf, invalid UTF-8) — and nothing is returned:
+// `error` says why, and the caller falls back to writePipeline(). `original` not parsing
+// is reported the same way. Parameter order in `edited` does not matter (matched by
+// name); new ones are appended in `edited`'s order. With nothing to change, the result is
+// `original`, byte for byte. `edited.fileName` is ignored.
+std::optional<std::string> patchPipelineText(const std::string& original, const PipelineDesc& edited,
+                                             std::string& error);
 
 // Byte offset (0-based) → 1-based line and column (column counts bytes).
 void lineColumn(const std::string& text, size_t offset, int& line, int& column);
