@@ -676,7 +676,9 @@ std::string literalText(const ParamLiteral& l) {
         return out + "]";
     }
     try {
-        return toJson(l).dump();
+        const Json j = toJson(l);
+        if (j.is_discarded()) throw std::runtime_error("an object value whose text is not JSON");
+        return j.dump();
     } catch (const Json::exception&) {
         throw std::runtime_error("a string in it is not valid UTF-8");
     }
@@ -810,7 +812,7 @@ std::optional<std::string> patchPipelineText(const std::string& original, const 
                     if (!before) {
                         added.emplace_back(keyText(name), literalText(value));
                     } else if (!sameLiteral(*before, value)) {
-                        const JsonSpan::Member* m = params->value.member(name);
+                        const JsonSpan::Member* m = params ? params->value.member(name) : nullptr;
                         if (!m) {
                             error = passLabel(i, was) + ": cannot find parameter \"" + elide(name, 40) + "\" in the text";
                             return std::nullopt;
