@@ -154,6 +154,10 @@ std::string textureKey(const TextureDecl& t) {
 
 class Compiler {
 public:
+    static std::optional<ParamValue> checkValue(const ParamLiteral& l, const ParamDecl& d, std::string& problem) {
+        return convert(l, d, problem);
+    }
+
     Compiler(const PipelineDesc& desc, const CompileOptions& opt) : desc_(desc), opt_(opt) {}
 
     Result<Plan> run() {
@@ -664,6 +668,10 @@ private:
 };
 
 }  // namespace
+
+std::optional<ParamValue> checkParamValue(const ParamValue& v, const ParamDecl& d, std::string& problem) {
+    return Compiler::checkValue(ParamLiteral::of(v), d, problem);
+}
 
 Result<Plan> compile(const PipelineDesc& desc, const CompileOptions& options) {
     return Compiler(desc, options).run();

@@ -65,6 +65,9 @@ struct CompileOptions {
 // On success, the Plan (with Plan::warnings). On failure, errors() holds every error
 // and warning found, sorted by their place in the file ("output" first).
 Result<Plan> compile(const PipelineDesc&, const CompileOptions&);
+// Checks a value against its declaration as compile() does a file's (type, range,
+// choices); the value as the parameter holds it, or nullopt and `problem` says why.
+std::optional<ParamValue> checkParamValue(const ParamValue&, const ParamDecl&, std::string& problem);
 
 // parsePipeline + compile.
 Result<Plan> compileText(const std::string& text, const std::string& fileName, const CompileOptions&);

@@ -293,14 +293,19 @@ private:
 
 // nlohmann's what(): "[json.exception.parse_error.101] parse error at line 3, column 5:
 // syntax error while parsing ..." — keep only the part after the position.
+// Its "last read: '...'" quotes the whole token, which an unterminated string makes
+// as long as the file: keep the end of it, where the parser stopped.
 std::string syntaxMessage(const std::string& what) {
-    const std::string marker = "parse error";
-    size_t p = what.find(marker);
-    if (p != std::string::npos) {
-        size_t colon = what.find(": ", p);
-        if (colon != std::string::npos) return what.substr(colon + 2);
+    std::string message = what;
+    if (size_t p = what.find("parse error"); p != std::string::npos)
+        if (size_t colon = what.find(": ", p); colon != std::string::npos) message = what.substr(colon + 2);
+    const std::string lastRead = "; last read: '";
+    if (size_t p = message.find(lastRead); p != std::string::npos) {
+        const size_t start = p + lastRead.size(), quoted = message.size() - start - 1;  // up to the closing '
+        constexpr size_t kShown = 40;
+        if (quoted > kShown) message = message.substr(0, start) + "..." + message.substr(message.size() - 1 - kShown);
     }
-    return what;
+    return elide(message, 300);
 }
 
 // Deeper than any pipeline needs (passes[i].params.x[j] is 4): bounds the stack of
@@ -416,6 +421,16 @@ std::string collapseFlatArrays(const std::string& text) {
 }
 
 }  // namespace
+
+void setParamLiteral(PassDesc& pass, const std::string& name, const ParamValue& value) {
+    ParamLiteral literal = ParamLiteral::of(value);
+    for (auto& [k, v] : pass.params)
+        if (k == name) {
+            v = std::move(literal);
+            return;
+        }
+    pass.params.emplace_back(name, std::move(literal));
+}
 
 ParamLiteral ParamLiteral::of(const ParamValue& v) {
     Json j;

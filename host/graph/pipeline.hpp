@@ -60,6 +60,9 @@ struct PassDesc {
     std::string note;
 };
 
+// Sets (or adds, at the end) the file's value of parameter `name`.
+void setParamLiteral(PassDesc&, const std::string& name, const ParamValue&);
+
 struct PipelineDesc {
     std::string fileName;             // for messages; "pipelines/default.json"
     std::string schema;               // "$schema", kept so writing back keeps it
