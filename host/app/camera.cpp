@@ -4,6 +4,8 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "kiln/scene_view.hpp"
+
 namespace kiln::app {
 
 glm::vec3 OrbitCamera::position() const {
@@ -12,7 +14,7 @@ glm::vec3 OrbitCamera::position() const {
 
 glm::mat4 OrbitCamera::view() const { return glm::lookAt(position(), target, glm::vec3(0, 1, 0)); }
 
-glm::mat4 OrbitCamera::projection(float aspect) const { return glm::perspective(fovY, aspect, 0.05f, 20.0f); }
+glm::mat4 OrbitCamera::projection(float aspect) const { return glm::perspective(fovY, aspect, kCameraNear, kCameraFar); }
 
 void OrbitCamera::rayThrough(double x, double y, int width, int height, glm::vec3& origin,
                              glm::vec3& direction) const {

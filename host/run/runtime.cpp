@@ -5,6 +5,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "graph/compiler.hpp"
+#include "graph/pipeline.hpp"
 #include "kiln/log.hpp"
 
 namespace fs = std::filesystem;
@@ -61,11 +63,23 @@ bool Runtime::loadPipeline(const fs::path& file, std::string& errors) {
 }
 
 bool Runtime::loadPipelineText(const std::string& text, const std::string& displayName, std::string& errors) {
+    auto parsed = graph::parsePipeline(text, displayName);
+    if (!parsed) {
+        errors = parsed.errorText();
+        return false;
+    }
+    if (!loadPipelineDesc(std::move(*parsed), errors)) return false;
+    pipelineText_ = text;
+    pipelineFile_ = displayName;
+    return true;
+}
+
+bool Runtime::loadPipelineDesc(graph::PipelineDesc desc, std::string& errors) {
     graph::CompileOptions opt;
     opt.resolve = [this](const std::string& m) { return modules_->declaration(m); };
     opt.availableModules = modules_->loader().available();
     opt.requested = requested_;
-    auto result = graph::compileText(text, displayName, opt);
+    auto result = graph::compile(desc, opt);
     if (!result) {
         errors = result.errorText();
         return false;
@@ -75,9 +89,45 @@ bool Runtime::loadPipelineText(const std::string& text, const std::string& displ
         return false;
     }
     for (auto& w : result->warnings) log::warn(w.str());
-    pipelineText_ = text;
-    pipelineFile_ = displayName;
+    desc_ = std::move(desc);
     adoptPlan(std::move(*result));
+    return true;
+}
+
+bool Runtime::setParam(const std::string& passId, const std::string& name, const ParamValue& value, std::string& error) {
+    const int index = plan_ ? plan_->find(passId) : -1;
+    const int descIndex = desc_ ? desc_->find(passId) : -1;
+    if (index < 0 || descIndex < 0) {
+        error = "no pass \"" + passId + "\" in the running pipeline";
+        return false;
+    }
+    graph::PlannedPass& planned = plan_->passes[size_t(index)];
+    auto decl = std::find_if(planned.decl.params.begin(), planned.decl.params.end(),
+                             [&](const ParamDecl& d) { return d.name == name; });
+    if (decl == planned.decl.params.end()) {
+        error = passId + ": module " + planned.module + " has no parameter \"" + name + "\"";
+        return false;
+    }
+    std::string problem;
+    std::optional<ParamValue> checked = graph::checkParamValue(value, *decl, problem);
+    if (!checked) {
+        error = passId + ".params." + name + ": " + problem;
+        return false;
+    }
+    const bool sizesATexture = [&] {
+        for (const auto* list : {&planned.decl.outputs, &planned.decl.internals})
+            for (const TextureDecl& t : *list)
+                if (t.size.mode == SizeRule::Mode::FromParam && t.size.source == name) return true;
+        return false;
+    }();
+    if (sizesATexture) {
+        graph::PipelineDesc edited = *desc_;
+        graph::setParamLiteral(edited.passes[size_t(descIndex)], name, *checked);
+        return loadPipelineDesc(std::move(edited), error);
+    }
+    graph::setParamLiteral(desc_->passes[size_t(descIndex)], name, *checked);
+    *planned.params.find(name) = *checked;
+    slots_[size_t(index)]->invalidate(false);
     return true;
 }
 
@@ -88,9 +138,9 @@ void Runtime::setRequested(std::vector<std::string> requested) {
 }
 
 void Runtime::recompilePlan() {
-    if (pipelineText_.empty()) return;
+    if (!desc_) return;
     std::string errors;
-    if (!loadPipelineText(pipelineText_, pipelineFile_, errors)) log::error(errors);
+    if (!loadPipelineDesc(*desc_, errors)) log::error(errors);
 }
 
 void Runtime::adoptPlan(graph::Plan plan) {
@@ -314,7 +364,7 @@ std::vector<PassRow> Runtime::stats() const {
 std::vector<NamedTexture> Runtime::textures() const {
     std::vector<NamedTexture> out;
     for (auto& s : slots_)
-        for (auto& [name, t] : s->textures) out.push_back({s->id, name, t.internal, t.ref});
+        for (auto& [name, t] : s->textures) out.push_back({s->id, name, t.internal, t.ref, t.decl.depthNear, t.decl.depthFar});
     return out;
 }
 

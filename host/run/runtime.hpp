@@ -41,6 +41,15 @@ public:
     // plan stays and `errors` holds every diagnostic (with JSON paths).
     bool loadPipeline(const std::filesystem::path& file, std::string& errors);
     bool loadPipelineText(const std::string& text, const std::string& displayName, std::string& errors);
+    // An edited description of the running pipeline (the debug view's toggles): the
+    // file and its text stay what they were.
+    bool loadPipelineDesc(graph::PipelineDesc, std::string& errors);
+    // The debug view's parameter edit without a recompile: the value is checked against
+    // its declaration (`error` says why not), written into the running plan and the
+    // description, and the pass runs again next frame with the same object, programs
+    // and textures. A parameter a texture's size is taken from recompiles (its textures
+    // must be reallocated).
+    bool setParam(const std::string& passId, const std::string& name, const ParamValue& value, std::string& error);
     // Textures the debug view shows or --dump wants ("pass.output"): un-culls their
     // producers without touching anyone's textures.
     void setRequested(std::vector<std::string> requested);
@@ -62,7 +71,10 @@ public:
     const TextureRef* findTexture(std::string_view pass, std::string_view name) const;
     const graph::Plan* plan() const { return plan_ ? &*plan_ : nullptr; }
     const std::string& pipelineFile() const { return pipelineFile_; }
+    // The pipeline file's text as last loaded, and the description now running (the
+    // loaded one with the debug view's edits).
     const std::string& pipelineText() const { return pipelineText_; }
+    const graph::PipelineDesc* pipelineDesc() const { return desc_ ? &*desc_ : nullptr; }
     std::vector<PassRow> stats() const;
     std::string statsTable() const { return formatStatsTable(stats()); }
     std::vector<NamedTexture> textures() const;
@@ -100,6 +112,7 @@ private:
     std::unique_ptr<ShaderLibrary> shaders_;
     std::optional<graph::Plan> plan_;
     std::string pipelineText_, pipelineFile_;
+    std::optional<graph::PipelineDesc> desc_;
     std::vector<std::string> requested_;
     std::vector<std::unique_ptr<PassSlot>> slots_;  // parallel to plan_->passes
     gl::Buffer frameUniforms_;

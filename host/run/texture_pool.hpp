@@ -68,6 +68,7 @@ struct NamedTexture {
     std::string pass, name;
     bool internal;
     TextureRef ref;
+    float depthNear = 0.0f, depthFar = 0.0f;  // TextureDecl's: how to linearise a depth texture
 };
 
 // Writes each texture into `dir` as PASS.NAME.png (clamped to [0,1]) and, for float

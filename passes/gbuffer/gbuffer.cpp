@@ -12,7 +12,8 @@ public:
         d.output({.name = "albedo", .format = Format::RGBA8, .doc = "linear albedo"})
             .output({.name = "normal", .format = Format::RGBA16F, .doc = "world-space unit normal; w = 1 on geometry"})
             .output({.name = "emissive", .format = Format::RGBA16F, .doc = "emitted radiance"})
-            .output({.name = "depth", .kind = TextureKind::Depth2D, .format = Format::Depth32F})
+            .output({.name = "depth", .kind = TextureKind::Depth2D, .format = Format::Depth32F,
+                     .depthNear = kCameraNear, .depthFar = kCameraFar})
             .param(boolParam("particles", true, "draw the particles"));
         d.reads = kSceneStatic | kSceneBodies | kSceneParticles | kSceneCamera;
         return d;

@@ -86,6 +86,9 @@ struct TextureDecl {  // an output (bindable by later passes) or an internal tex
     SizeRule size = SizeRule::relative();
     int mips = 1;
     std::string doc;
+    // Depth written through a perspective projection: its near and far planes, so a
+    // viewer can show linear distance (both 0: orthographic or unknown, shown as stored).
+    float depthNear = 0.0f, depthFar = 0.0f;
 };
 
 enum class ParamType : uint8_t { Bool, Int, Float, Enum, Color };

@@ -127,7 +127,7 @@
 namespace kiln {
 
 // Bump when anything in this header (or what it includes) changes layout or vtables.
-inline constexpr uint32_t kPassAbiVersion = 3;
+inline constexpr uint32_t kPassAbiVersion = 4;
 
 struct TextureRef {
     GLuint id = 0;

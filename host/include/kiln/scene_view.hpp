@@ -45,6 +45,10 @@ struct GpuFrame {
                              //   b, upper radius t, half-angle α (rad), upper centre y_t
 };
 
+// The host camera's clip planes (GpuFrame::proj): what a pass that rasterises from the
+// camera declares as its depth output's depthNear/depthFar.
+inline constexpr float kCameraNear = 0.05f, kCameraFar = 20.0f;
+
 inline constexpr unsigned kFrameBinding = 0;      // uniform block
 inline constexpr unsigned kInstanceBinding = 0;   // shader storage block
 
