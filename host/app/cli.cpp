@@ -11,8 +11,8 @@ const char* kUsage = R"(kiln — a render-pass framework with hot reload
 
 usage: kiln [options]
 
-  --pipeline FILE   pipeline graph (default pipelines/default.json)
-  --scene FILE      scene description (default scenes/cornell.json)
+  --pipeline FILE   pipeline graph (default pipelines/default.json, see below)
+  --scene FILE      scene description (default scenes/cornell.json, see below)
   --headless        render with EGL, no window
   --size WxH        output size (default 720x720)
   --frames N        frames to render in headless mode (default 1)
@@ -26,9 +26,12 @@ usage: kiln [options]
   --view PASS.OUT   show this texture instead of the graph output (un-culls its producer)
   --screenshot F    window mode: save the window (debug view included) after
                     --frames frames, then quit
+  --ui-probe FILE   window mode: keep FILE (JSON) up to date with where each
+                    debug-view widget is on screen and what the texture readout
+                    says, so scripts (xdotool) can drive the window
   --seed N          simulation seed (same seed, same frames)
   --paused          do not advance the simulation
-  --shaders DIR     shader root (default shaders/)
+  --shaders DIR     shader root (default shaders/, see below)
   --modules DIRS    pass module directories, ':'-separated (default: the build's modules/)
   --help            this text
 
@@ -48,12 +51,28 @@ bool parseInt(std::string_view s, long long& out) {
 }
 }  // namespace
 
+std::filesystem::path defaultDataRoot() {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    const fs::path cwd = fs::current_path(ec);
+    // A copied tree edits and writes back its own files, not the ones it was built from.
+    if (!ec && fs::is_regular_file(cwd / "pipelines/default.json", ec) && fs::is_regular_file(cwd / "shaders/common/frame.glsl", ec))
+        return cwd;
+    return KILN_SOURCE_DIR;
+}
+
 void applyDefaults(Options& o) {
-    const std::filesystem::path source = KILN_SOURCE_DIR;
-    if (o.pipeline.empty()) o.pipeline = (source / "pipelines/default.json").string();
-    if (o.scene.empty()) o.scene = (source / "scenes/cornell.json").string();
-    if (o.shaderRoot.empty()) o.shaderRoot = (source / "shaders").string();
+    const std::filesystem::path root = defaultDataRoot();
+    if (o.pipeline.empty()) o.pipeline = (root / "pipelines/default.json").string();
+    if (o.scene.empty()) o.scene = (root / "scenes/cornell.json").string();
+    if (o.shaderRoot.empty()) o.shaderRoot = (root / "shaders").string();
     if (o.moduleDir.empty()) o.moduleDir = KILN_MODULE_DIR;
+}
+
+std::string usage() {
+    return std::string(kUsage) + "\nDefault files come from " + defaultDataRoot().string() +
+           "\n  (the working directory when it has pipelines/default.json and shaders/, else the source tree\n"
+           "  Kiln was built from); modules from " + KILN_MODULE_DIR + "\n";
 }
 
 std::optional<Options> parseOptions(int argc, char** argv, std::string& error) {
@@ -82,7 +101,7 @@ std::optional<Options> parseOptions(int argc, char** argv, std::string& error) {
         } else if (a == "--paused") {
             o.paused = true;
         } else if (a == "--pipeline" || a == "--scene" || a == "--out" || a == "--dump" || a == "--dot" ||
-                   a == "--shaders" || a == "--modules" || a == "--view" || a == "--screenshot") {
+                   a == "--shaders" || a == "--modules" || a == "--view" || a == "--screenshot" || a == "--ui-probe") {
             auto v = value(a);
             if (!v) return std::nullopt;
             std::string* dst = a == "--pipeline" ? &o.pipeline
@@ -93,6 +112,7 @@ std::optional<Options> parseOptions(int argc, char** argv, std::string& error) {
                              : a == "--shaders"  ? &o.shaderRoot
                              : a == "--modules"  ? &o.moduleDir
                              : a == "--screenshot" ? &o.screenshot
+                             : a == "--ui-probe" ? &o.uiProbe
                                                  : &o.view;
             *dst = *v;
         } else if (a == "--size") {

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <filesystem>
 #include <optional>
 #include <string>
 
@@ -29,14 +30,20 @@ struct Options {
     bool help = false;
     std::string screenshot;   // window: save the window after --frames frames and quit
     std::string view;         // "pass.output" to show instead of the graph output
+    std::string uiProbe;      // window: JSON file of widget rectangles and readouts
 };
 
 extern const char* kUsage;
 
 // Parses argv; on a bad argument returns nullopt and sets `error` to one line.
 std::optional<Options> parseOptions(int argc, char** argv, std::string& error);
-// Fills unset paths: the source tree's pipelines/default.json, scenes/cornell.json,
-// shaders/, and the build's modules/ directory.
+// Where unset paths point: the working directory when it holds a Kiln tree
+// (pipelines/default.json and shaders/), else the source tree Kiln was built from.
+std::filesystem::path defaultDataRoot();
+// Fills unset paths: pipelines/default.json, scenes/cornell.json and shaders/ under
+// defaultDataRoot(), and the build's modules/ directory.
 void applyDefaults(Options&);
+// kUsage and where the defaults come from on this machine.
+std::string usage();
 
 }  // namespace kiln::app

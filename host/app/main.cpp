@@ -62,7 +62,7 @@ int main(int argc, char** argv) {
     if (!parsed) return fail(error);
     Options o = *parsed;
     if (o.help) {
-        std::printf("%s", kUsage);
+        std::printf("%s", usage().c_str());
         return 0;
     }
     applyDefaults(o);

@@ -133,3 +133,30 @@ TEST_CASE("bad command lines exit non-zero with one line on stderr", "[integrati
         CHECK(std::count(r.err.begin(), r.err.end(), '\n') == 1);
     }
 }
+
+TEST_CASE("default files come from a Kiln tree in the working directory, else the source tree", "[integration][cli]") {
+    // A copied tree whose pipeline is broken: run from inside the copy, kiln must read
+    // (and name) the copy's file, not the source tree's it was built from.
+    const fs::path copy = fs::path(TEST_OUTPUT_DIR) / ("tree-copy-" + std::to_string(getpid()));
+    fs::remove_all(copy);
+    fs::create_directories(copy / "pipelines");
+    fs::copy(fs::path(KILN_SOURCE_DIR) / "shaders", copy / "shaders", fs::copy_options::recursive);
+    fs::copy(fs::path(KILN_SOURCE_DIR) / "scenes", copy / "scenes", fs::copy_options::recursive);
+    std::ofstream(copy / "pipelines/default.json") << "{ broken";
+    const Run inCopy = runKiln("--headless --size 16x16", 60, copy.string());
+    INFO(inCopy.err);
+    CHECK(inCopy.exitCode == 1);
+    CHECK_THAT(inCopy.err, Catch::Contains((copy / "pipelines/default.json").string()));
+    const Run help = runKiln("--help", 60, copy.string());
+    CHECK_THAT(help.out, Catch::Contains("Default files come from " + copy.string()));
+
+    // Outside any tree: the source tree's files, which render.
+    const fs::path empty = fs::path(TEST_OUTPUT_DIR) / ("no-tree-" + std::to_string(getpid()));
+    fs::create_directories(empty);
+    const Run outside = runKiln("--headless --size 16x16 --out " + (empty / "o.png").string(), 120, empty.string());
+    INFO(outside.err);
+    CHECK(outside.exitCode == 0);
+    CHECK(fs::file_size(empty / "o.png") > 0);
+    fs::remove_all(copy);
+    fs::remove_all(empty);
+}

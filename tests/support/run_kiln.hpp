@@ -26,12 +26,14 @@ inline std::string slurp(const std::filesystem::path& p) {
     return ss.str();
 }
 
-inline Run runProgram(const std::string& binary, const std::string& args, int timeoutSeconds = 120) {
+// `cwd`: the working directory to run in (empty: the test's own).
+inline Run runProgram(const std::string& binary, const std::string& args, int timeoutSeconds = 120,
+                      const std::string& cwd = {}) {
     static int serial = 0;
     std::filesystem::create_directories(TEST_OUTPUT_DIR);
     const std::string base = std::string(TEST_OUTPUT_DIR) + "/run-" + std::to_string(getpid()) + "-" + std::to_string(++serial);
     const std::string out = base + ".out", err = base + ".err";
-    const std::string cmd = "timeout -s KILL " + std::to_string(timeoutSeconds) + " " + binary + " " +
+    const std::string cmd = (cwd.empty() ? "" : "cd '" + cwd + "' && ") + "timeout -s KILL " + std::to_string(timeoutSeconds) + " " + binary + " " +
                             args + " > " + out + " 2> " + err;
     const int status = std::system(cmd.c_str());
     int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
@@ -39,8 +41,8 @@ inline Run runProgram(const std::string& binary, const std::string& args, int ti
     return {code, slurp(out), slurp(err)};
 }
 
-inline Run runKiln(const std::string& args, int timeoutSeconds = 120) {
-    return runProgram(KILN_BINARY, args, timeoutSeconds);
+inline Run runKiln(const std::string& args, int timeoutSeconds = 120, const std::string& cwd = {}) {
+    return runProgram(KILN_BINARY, args, timeoutSeconds, cwd);
 }
 
 }  // namespace kiln::test
