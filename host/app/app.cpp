@@ -2,6 +2,7 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include <algorithm>
 #include <cmath>
 
 #include "kiln/log.hpp"
@@ -100,17 +101,34 @@ SceneView App::buildView() {
     return v;
 }
 
-void App::frame() {
+void App::frame(double wallSeconds) {
     live_.poll(*this);  // edits land at a frame boundary, on this thread
     if (viewed != requestedView_) {
         requestedView_ = viewed;
         runtime_.setRequested(viewed.empty() ? std::vector<std::string>{} : std::vector<std::string>{viewed});
     }
-    if (!paused || singleStep) {
-        scene_.step();
-        ++timeVersion_;
-        singleStep = false;
+    int steps = 0;
+    if (singleStep) {
+        steps = 1;
+    } else if (!paused) {
+        if (wallSeconds < 0.0) {
+            steps = 1;
+        } else {
+            const double dt = scene_.dt();
+            accumulator_ += std::max(0.0, wallSeconds) * std::max(0.0, timeScale);
+            steps = int(std::floor(accumulator_ / dt));
+            accumulator_ -= steps * dt;
+            if (steps > kMaxStepsPerFrame) {
+                droppedSeconds += (steps - kMaxStepsPerFrame) * dt;
+                steps = kMaxStepsPerFrame;
+            }
+        }
     }
+    if (paused) accumulator_ = 0.0;
+    singleStep = false;
+    for (int i = 0; i < steps; ++i) scene_.step();
+    if (steps > 0) ++timeVersion_;
+    lastSteps = steps;
     const SceneView view = buildView();
     FrameInfo info;
     info.index = frameIndex_++;

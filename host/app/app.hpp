@@ -23,13 +23,22 @@ class App {
 public:
     bool init(const Options&, std::string& error);
     // Steps the simulation (unless paused), builds the scene view, runs the graph.
-    void frame();
+    // Headless (wallSeconds < 0): one fixed step per frame, so frame N is the same
+    // everywhere. Window: simulated time follows the wall clock × timeScale in fixed
+    // steps (an accumulator); at most kMaxStepsPerFrame a frame, so a slow frame slows
+    // the simulation down instead of stalling on a backlog of steps.
+    void frame(double wallSeconds = -1.0);
+    static constexpr int kMaxStepsPerFrame = 4;
+    double timeScale = 1.0;
+    int lastSteps = 0;          // steps taken in the last frame
+    double droppedSeconds = 0;  // simulated time given up to the step cap, in total
     // The graph output, or the texture chosen with --view / in the debug view.
     const TextureRef* displayedTexture() const;
 
     // The window's framebuffer changed size: reallocate size-relative textures.
     void resize(int width, int height);
     Runtime& runtime() { return runtime_; }
+    const Runtime& runtime() const { return runtime_; }
     scene::LiveScene& scene() { return scene_; }
     OrbitCamera& camera() { return camera_; }
     LiveReload& live() { return live_; }
@@ -53,6 +62,7 @@ private:
     uint64_t frameIndex_ = 0;
     glm::mat4 lastViewProj_{0.0f};
     uint64_t cameraVersion_ = 0, timeVersion_ = 0;
+    double accumulator_ = 0.0;
     std::string requestedView_;  // what the runtime was last asked to keep un-culled
     int refusedWidth_ = 0, refusedHeight_ = 0;  // a size the runtime refused
 };
