@@ -26,6 +26,8 @@ usage: kiln [options]
   --view PASS.OUT   show this texture instead of the graph output (un-culls its producer)
   --screenshot F    window mode: save the window (debug view included) after
                     --frames frames, then quit
+  --budget MS       window: lower the render resolution while frames take
+                    longer than MS (default 100; 0 keeps full resolution)
   --ui-probe FILE   window mode: keep FILE (JSON) up to date with where each
                     debug-view widget is on screen and what the texture readout
                     says, so scripts (xdotool) can drive the window
@@ -127,6 +129,15 @@ std::optional<Options> parseOptions(int argc, char** argv, std::string& error) {
             }
             o.width = static_cast<int>(w);
             o.height = static_cast<int>(h);
+        } else if (a == "--budget") {
+            auto v = value(a);
+            if (!v) return std::nullopt;
+            long long n = 0;
+            if (!parseInt(*v, n) || n < 0 || n > 100000) {
+                error = "--budget " + *v + ": expected milliseconds, 0 to 100000 (0: off)";
+                return std::nullopt;
+            }
+            o.budgetMs = static_cast<int>(n);
         } else if (a == "--frames" || a == "--seed") {
             auto v = value(a);
             if (!v) return std::nullopt;

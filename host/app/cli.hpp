@@ -30,6 +30,7 @@ struct Options {
     bool help = false;
     std::string screenshot;   // window: save the window after --frames frames and quit
     std::string view;         // "pass.output" to show instead of the graph output
+    int budgetMs = 100;       // window: frame-time budget for the render resolution (0: off)
     std::string uiProbe;      // window: JSON file of widget rectangles and readouts
 };
 

@@ -240,6 +240,7 @@ void TextureViewer::window(const run::NamedTexture& nt, bool* open) {
     // Data without a natural 0..1 (depth, counts, one float channel) is fitted when first
     // shown; colour starts at 0..1.
     if (!s.fitted && !isSingleChannel(t.format)) s.fitted = true;
+    if (!s.fitted) s.channel = 1;  // one channel: shown in false colour
     if (fitNow || autoFit_ || !s.fitted) fit_ = fitRange(t, nt.depthNear, nt.depthFar, s, canvas), s.fitted = true;
     glBindFramebuffer(GL_FRAMEBUFFER, canvasFbo_.id());
     draw(t, nt.depthNear, nt.depthFar, s, {0, 0, size.x, size.y});
@@ -248,6 +249,7 @@ void TextureViewer::window(const run::NamedTexture& nt, bool* open) {
     const ImVec2 p0 = ImGui::GetCursorScreenPos();
     ImGui::InvisibleButton("canvas", ImVec2(float(size.x), float(size.y)));
     const bool hovered = ImGui::IsItemHovered(), active = ImGui::IsItemActive();
+    canvasRect_ = {p0.x, p0.y, p0.x + size.x, p0.y + size.y};
     ImGui::GetWindowDrawList()->AddImage(ImTextureID(intptr_t(canvas_.id())), p0, ImVec2(p0.x + size.x, p0.y + size.y),
                                          ImVec2(0, 1), ImVec2(1, 0));
     // Canvas pixel of the cursor, origin bottom-left like the shader's.

@@ -67,6 +67,8 @@ public:
     void draw(const TextureRef& t, float depthNear, float depthFar, const ViewSettings& s, glm::ivec4 rect) const;
     // The "Texture" ImGui window for `t`: toolbar, canvas, readout, histogram.
     void window(const run::NamedTexture& t, bool* open);
+    // Screen rectangle of the canvas in the last window() (x0, y0, x1, y1), for --ui-probe.
+    glm::vec4 canvasRect() const { return canvasRect_; }
 
     ViewSettings& settingsFor(const std::string& name) { return settings_[name]; }
     const std::optional<TexelReadout>& lastReadout() const { return readout_; }
@@ -87,6 +89,7 @@ private:
     std::optional<RangeFit> fit_;
     std::string fitFor_;           // which texture fit_ describes
     bool autoFit_ = false;
+    glm::vec4 canvasRect_{0.0f};
 };
 
 }  // namespace kiln::app

@@ -40,7 +40,7 @@ struct UiProbe {
 
     bool on() const { return !path.empty(); }
     void item(const std::string& id) {
-        if (!on()) return;
+        if (!on() || !ImGui::IsItemVisible()) return;  // scrolled away or clipped: not clickable
         const ImVec2 a = ImGui::GetItemRectMin(), b = ImGui::GetItemRectMax();
         widgets[id] = {a.x, a.y, b.x, b.y};
     }
@@ -173,8 +173,11 @@ void panelParams(WindowState& state) {
     const graph::PlannedPass pass = plan->passes[size_t(index)];
     ImGui::PushID("params");
     ImGui::PushID(pass.id.c_str());
-    ImGui::Separator();
-    ImGui::Text("%s parameters", pass.id.c_str());
+    ImGui::Text("%s (%s)", pass.id.c_str(), pass.module.c_str());
+    ImGui::SameLine();
+    if (ImGui::SmallButton("write back")) editor.writeBack(app);
+    state.probe.item("write-back");
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("writes the edited values (only those) into %s", app.runtime().pipelineFile().c_str());
     for (const ParamDecl& decl : pass.decl.params) {
         const ParamValue* current = pass.params.find(decl.name);
         if (!current) continue;
@@ -191,9 +194,6 @@ void panelParams(WindowState& state) {
             editor.setParam(app, pass.id, decl.name, edited);
         }
     }
-    if (ImGui::Button("write back to the pipeline file")) editor.writeBack(app);
-    state.probe.item("write-back");
-    if (ImGui::IsItemHovered()) ImGui::SetTooltip("changes only the edited values in %s", app.runtime().pipelineFile().c_str());
     ImGui::PopID();
     ImGui::PopID();
 }
@@ -211,7 +211,7 @@ void listPipelines(WindowState& state) {
 void pipelineSwitcher(WindowState& state) {
     App& app = *state.app;
     const std::string current = fs::path(app.runtime().pipelineFile()).filename().string();
-    ImGui::SetNextItemWidth(-1);
+    ImGui::SetNextItemWidth(-60);
     if (ImGui::BeginCombo("##pipeline", current.c_str())) {
         if (ImGui::IsWindowAppearing()) listPipelines(state);
         for (const std::string& p : state.pipelines) {
@@ -235,6 +235,9 @@ void panelPasses(WindowState& state) {
     App& app = *state.app;
     PipelineEditor& editor = state.editor;
     pipelineSwitcher(state);
+    ImGui::SameLine();
+    if (ImGui::SmallButton("graph")) state.showGraph = !state.showGraph;
+    state.probe.item("show-graph");
     if (ImGui::BeginTable("passes", 4, ImGuiTableFlags_RowBg | ImGuiTableFlags_BordersInnerV | ImGuiTableFlags_SizingFixedFit)) {
         ImGui::TableSetupColumn("pass", ImGuiTableColumnFlags_WidthStretch);
         ImGui::TableSetupColumn("state");
@@ -279,7 +282,6 @@ void panelPasses(WindowState& state) {
         ImGui::TextColored(ImVec4(1, 0.4f, 0.4f, 1), "%s", editor.error.c_str());
         ImGui::PopTextWrapPos();
     }
-    panelParams(state);
 }
 
 void panelTextures(WindowState& state) {
@@ -287,8 +289,12 @@ void panelTextures(WindowState& state) {
     if (ImGui::RadioButton("image: graph output", !state.mainShowsSelection)) state.mainShowsSelection = false;
     ImGui::SameLine();
     if (ImGui::RadioButton("selected texture", state.mainShowsSelection)) state.mainShowsSelection = true;
+    static ImGuiTextFilter filter;
+    filter.Draw("filter", 160);
+    state.probe.item("texture-filter");
     for (auto& t : app.runtime().textures()) {
         const std::string name = t.pass + "." + t.name;
+        if (!filter.PassFilter(name.c_str())) continue;
         const std::string label = name + (t.internal ? " (internal)" : "") + "  " + std::to_string(t.ref.width) + "x" +
                                   std::to_string(t.ref.height) +
                                   (t.ref.target == GL_TEXTURE_3D ? "x" + std::to_string(t.ref.depth) : "") + " " +
@@ -410,25 +416,25 @@ void drawSidebar(WindowState& state) {
         ImGui::SetNextWindowPos(ImVec2(0, y), ImGuiCond_FirstUseEver);
         ImGui::SetNextWindowSize(ImVec2(float(kSidebarWidth), height), ImGuiCond_FirstUseEver);
     };
-    place(0, h * 0.5f);
+    place(0, h * 0.36f);
     if (ImGui::Begin("Passes (F1 hides the panels)")) panelPasses(state);
     ImGui::End();
-    place(h * 0.5f, h * 0.3f);
+    place(h * 0.36f, h * 0.24f);
+    if (ImGui::Begin("Parameters")) panelParams(state);
+    ImGui::End();
+    place(h * 0.6f, h * 0.22f);
     if (ImGui::Begin("Textures")) panelTextures(state);
     ImGui::End();
-    place(h * 0.8f, h * 0.2f);
-    if (ImGui::Begin("Scene")) {
-        panelScene(state);
-        if (ImGui::Button(state.showGraph ? "hide graph" : "show graph")) state.showGraph = !state.showGraph;
-        state.probe.item("show-graph");
-    }
+    place(h * 0.82f, h * 0.18f);
+    if (ImGui::Begin("Scene")) panelScene(state);
     ImGui::End();
     if (state.showGraph) panelGraph(state, &state.showGraph);
     if (state.showTexture && !app.viewed.empty()) {
         for (auto& t : app.runtime().textures())
             if (t.pass + "." + t.name == app.viewed) {
                 state.viewer.window(t, &state.showTexture);
-                state.probe.item("texture-window-end");
+                const glm::vec4 c = state.viewer.canvasRect();
+                if (state.probe.on()) state.probe.widgets["texture-canvas"] = {c.x, c.y, c.z, c.w};
                 break;
             }
     }
@@ -521,7 +527,8 @@ void handleMouse(GLFWwindow* window, WindowState& state) {
 // The resolution budget: at most one change a second, in steps of 0.8 / 1.25, so a
 // single slow frame (a shader rebuild) does not halve the resolution.
 void followBudget(WindowState& state, double now) {
-    if (!state.autoScale || now - state.lastScaleChange < 1.0) return;
+    // The first seconds build every program: not what the scene costs.
+    if (!state.autoScale || now < 3.0 || now - state.lastScaleChange < 1.0) return;
     if (state.frameMs > state.budgetMs * 1.2 && state.renderScale > 0.125f) {
         state.renderScale = std::max(0.125f, state.renderScale * 0.8f);
         state.lastScaleChange = now;
@@ -593,6 +600,8 @@ int runWindow(const Options& o) {
     state.probe.path = o.uiProbe;
     state.mainShowsSelection = !o.view.empty();
     state.showTexture = !o.view.empty();
+    state.autoScale = o.budgetMs > 0;
+    state.budgetMs = o.budgetMs > 0 ? float(o.budgetMs) : state.budgetMs;
     if (!state.viewer.init(app.runtime().shaders(), error)) log::error(error);
     GLFWwindow* window = context->window();
     glfwSetWindowUserPointer(window, &state);
@@ -611,7 +620,7 @@ int runWindow(const Options& o) {
         glfwPollEvents();
         int fbW, fbH;
         glfwGetFramebufferSize(window, &fbW, &fbH);
-        const int sidebar = state.showDebug ? std::min(kSidebarWidth, fbW / 2) : 0;
+        const int sidebar = state.showDebug ? std::min(kSidebarWidth, fbW * 2 / 3) : 0;
         state.image = {sidebar, 0, std::max(1, fbW - sidebar), std::max(1, fbH)};
         handleMouse(window, state);
         const Clock::time_point now = Clock::now();

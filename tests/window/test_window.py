@@ -1,0 +1,214 @@
+#!/usr/bin/env python3
+"""The window as a user drives it: kiln under a virtual X server, clicked and typed at
+with xdotool, judged on what the screen shows (screenshots read back with ImageMagick)
+and on what a headless run of the same frame reads back. kiln --ui-probe says where each
+widget is; nothing else of the window's insides is used.
+
+usage: test_window.py KILN SOURCE_DIR OUT_DIR      (run under xvfb-run; ctest does)
+"""
+import difflib
+import json
+import os
+import shutil
+import subprocess
+import sys
+import time
+
+KILN, SOURCE, OUT = sys.argv[1], sys.argv[2], sys.argv[3]
+W, H = 320, 640  # the image; the window adds the panels' column
+failures = []
+
+
+def check(ok, what):
+    print(("ok   " if ok else "FAIL ") + what, flush=True)
+    if not ok:
+        failures.append(what)
+
+
+def sh(*args):
+    return subprocess.run(args, check=True, capture_output=True, text=True).stdout
+
+
+def probe():
+    for _ in range(50):
+        try:
+            with open(PROBE) as f:
+                return json.load(f)
+        except (OSError, ValueError):
+            time.sleep(0.1)
+    raise RuntimeError("no probe file")
+
+
+def wait_for(predicate, what, timeout=60):
+    deadline = time.time() + timeout
+    while time.time() < deadline:
+        if kiln.poll() is not None:
+            raise RuntimeError("kiln exited while waiting for " + what)
+        p = probe()
+        if predicate(p):
+            return p
+        time.sleep(0.2)
+    raise RuntimeError("timed out waiting for " + what + "; probe: " + json.dumps({k: v for k, v in probe().items() if k != "widgets"})[:2000])
+
+
+def frames_later(n=3):
+    """Waits until the window has drawn n more frames (what was clicked has landed)."""
+    start = probe()["frame"]
+    wait_for(lambda p: p["frame"] >= start + n, "%d frames" % n)
+
+
+def centre(widget):
+    x0, y0, x1, y1 = probe()["widgets"][widget]
+    return int((x0 + x1) / 2), int((y0 + y1) / 2)
+
+
+def click(widget, ctrl=False):
+    x, y = centre(widget)
+    sh("xdotool", "mousemove", "--window", WINDOW, str(x), str(y))
+    time.sleep(0.2)
+    if ctrl:
+        sh("xdotool", "keydown", "ctrl", "click", "1", "keyup", "ctrl")
+    else:
+        sh("xdotool", "click", "1")
+    frames_later()
+
+
+def screen_pixel(x, y, shot):
+    """The screenshot's RGB (0..255) at window pixel (x, y)."""
+    text = sh("convert", shot, "-crop", "1x1+%d+%d" % (x, y), "-depth", "8", "txt:-")
+    rgb = text.splitlines()[1].split("(")[1].split(")")[0].split(",")
+    return [float(c) for c in rgb[:3]]
+
+
+def screenshot(name):
+    path = os.path.join(OUT, name)
+    sh("import", "-window", WINDOW, path)
+    return path
+
+
+def image_mean(shot, p, size=9):
+    """Mean RGB of a size×size patch near the bottom of the image (the floor), where
+    the texture window, open at the top right, does not cover it."""
+    ix, iy, iw, ih = p["image"]
+    cx, cy = ix + iw * 3 // 4, iy + ih - 24
+    text = sh("convert", shot, "-crop", "%dx%d+%d+%d" % (size, size, cx - size // 2, cy - size // 2),
+              "-resize", "1x1!", "-depth", "16", "txt:-")
+    rgb = text.splitlines()[1].split("(")[1].split(")")[0].split(",")
+    return sum(float(c) for c in rgb[:3]) / 3
+
+
+os.makedirs(OUT, exist_ok=True)
+PROBE = os.path.join(OUT, "probe.json")
+pipelines = os.path.join(OUT, "pipelines")
+shutil.rmtree(pipelines, ignore_errors=True)
+shutil.copytree(os.path.join(SOURCE, "pipelines"), pipelines)
+default = os.path.join(pipelines, "default.json")
+original_text = open(default).read()
+if os.path.exists(PROBE):
+    os.remove(PROBE)
+
+# What a headless run reads back for the same paused frame at the same size.
+dump = os.path.join(OUT, "dump")
+shutil.rmtree(dump, ignore_errors=True)
+sh(KILN, "--headless", "--paused", "--size", "%dx%d" % (W, H), "--pipeline", default, "--dump", dump,
+   "--view", "gbuffer.albedo", "--no-live")
+
+kiln = subprocess.Popen([KILN, "--paused", "--size", "%dx%d" % (W, H), "--pipeline", default, "--budget", "0",
+                         "--ui-probe", PROBE], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+try:
+    wait_for(lambda p: p["frame"] >= 3, "the first frames")
+    WINDOW = sh("xdotool", "search", "--sync", "--name", "^Kiln$").split()[0]
+    p = probe()
+    check(p["image"][2] == W and p["image"][3] == H, "the image is %dx%d beside the panels: %s" % (W, H, p["image"]))
+
+    # 1. Select a texture: the texture window opens on it; the value under a known
+    #    texel is what the headless read-back has there.
+    click("texture:gbuffer.albedo")
+    p = wait_for(lambda p: p["viewed"] == "gbuffer.albedo" and "texture-canvas" in p["widgets"], "the texture window")
+    x0, y0, x1, y1 = p["widgets"]["texture-canvas"]
+    seen = set()
+    cw, ch = x1 - x0, y1 - y0
+    zoom = min(cw / W, ch / H)  # the canvas fits the whole texture, centred
+    for want in ((W // 2, H // 2), (6, H * 6 // 10), (W // 2, H // 12)):  # back wall, left wall, floor
+        sx = x0 + cw / 2 + (want[0] + 0.5 - W / 2) * zoom
+        sy = y1 - (ch / 2 + (want[1] + 0.5 - H / 2) * zoom)
+        sh("xdotool", "mousemove", "--window", WINDOW, str(int(sx)), str(int(sy)))
+        p = wait_for(lambda p: "readout" in p and all(abs(a - b) <= 2 for a, b in zip(p["readout"]["texel"], want)),
+                     "a readout near texel %s" % (want,))
+        tx, ty, _ = p["readout"]["texel"]
+        value = p["readout"]["value"]
+        seen.add(tuple(round(v, 3) for v in value[:3]))
+        # The dump's PNG is top row first; GL's row 0 is the bottom. RGBA8 is exact in PNG.
+        text = sh("convert", os.path.join(dump, "gbuffer.albedo.png"), "-crop", "1x1+%d+%d" % (tx, H - 1 - ty),
+                  "-depth", "8", "txt:-")
+        expected = [float(c) / 255 for c in text.splitlines()[1].split("(")[1].split(")")[0].split(",")[:3]]
+        check(all(abs(a - b) <= 0.5 / 255 for a, b in zip(value[:3], expected)),
+              "readout at texel (%d, %d) %s equals the headless read-back %s (within half a step of 8 bits)"
+              % (tx, ty, [round(v, 4) for v in value[:3]], [round(v, 4) for v in expected]))
+    check(len(seen) == 3, "three places, three different albedos: %s" % seen)
+
+    # 2. An integer texture (R32UI voxel counts) is not black: the fitted range is > 0.
+    click("texture-filter")
+    sh("xdotool", "type", "--window", WINDOW, "count")
+    wait_for(lambda p: "texture:voxelize.count" in p["widgets"], "voxelize.count in the filtered list")
+    click("texture:voxelize.count")
+    p = wait_for(lambda p: p["viewed"] == "voxelize.count" and "fit" in p, "a fit of voxelize.count")
+    check(p["fit"][1] >= 1, "voxelize.count (R32UI) fits to a range with counts: %s" % p["fit"])
+
+    # 3. A parameter: ctrl+click composite.exposure, type 0.25; the image darkens.
+    before = image_mean(screenshot("before.png"), probe())
+    click("pass:composite")
+    wait_for(lambda p: "param:composite.exposure" in p["widgets"], "composite's parameters")
+    click("param:composite.exposure", ctrl=True)
+    sh("xdotool", "key", "--window", WINDOW, "ctrl+a")
+    sh("xdotool", "type", "--window", WINDOW, "0.25")
+    sh("xdotool", "key", "--window", WINDOW, "Return")
+    p = wait_for(lambda p: p["passes"]["composite"]["params"]["exposure"] == "0.25", "exposure 0.25")
+    frames_later()
+    after = image_mean(screenshot("after.png"), probe())
+    check(after < before * 0.75, "exposure 1 -> 0.25 darkens the floor: mean %.0f -> %.0f (of 65535)" % (before, after))
+
+    # 4. Toggle a pass off.
+    click("pass-enabled:bloom")
+    p = wait_for(lambda p: p["passes"]["bloom"]["state"] == "disabled", "bloom disabled")
+    check(True, "bloom's checkbox disables it")
+
+    # 5. Write back: only the edited values change in the file.
+    click("write-back")
+    frames_later()
+    written = open(default).read()
+    expected_text = original_text.replace('"exposure": 1.0', '"exposure": 0.25', 1)
+    check(written != original_text and "\"exposure\": 0.25" in written, "write-back wrote the new exposure")
+    diff = [l for l in difflib.ndiff(original_text.splitlines(), written.splitlines()) if l[:1] in "+-"]
+    removed = [l for l in diff if l.startswith("-")]
+    added = [l for l in diff if l.startswith("+")]
+    check(len(removed) == 1 and "exposure" in removed[0] and len(added) == 2 and
+          any("\"exposure\": 0.25" in l for l in added) and any("\"enabled\": false" in l for l in added),
+          "write-back changed only the edited values (the exposure line, and enabled: false added to bloom): %s" % diff)
+
+    # 6. The graph view.
+    click("show-graph")
+    p = wait_for(lambda p: "graph-node:gbuffer" in p["widgets"], "the graph view")
+    check(True, "the graph view shows a node per pass")
+
+    # 7. Switch pipeline to voxels.json without a restart.
+    click("pipeline-switcher")
+    wait_for(lambda p: "pipeline:voxels.json" in p["widgets"], "the pipeline list")
+    click("pipeline:voxels.json")
+    p = wait_for(lambda p: p["pipeline"].endswith("voxels.json"), "voxels.json running")
+    check(not p["errors"] and not p["editor_error"], "voxels.json runs without errors: %s %s" % (p["errors"], p["editor_error"]))
+    screenshot("voxels.png")
+finally:
+    kiln.terminate()
+    try:
+        out, _ = kiln.communicate(timeout=30)
+    except subprocess.TimeoutExpired:
+        kiln.kill()
+        out, _ = kiln.communicate()
+    print(out[-3000:])
+    gl_errors = [l for l in out.splitlines() if "GL [" in l]
+    check(not gl_errors, "no GL errors: %s" % gl_errors[:3])
+    check(kiln.returncode in (0, -15), "kiln ended by the test, not by itself (exit %s)" % kiln.returncode)
+
+print("%d failure(s)" % len(failures))
+sys.exit(1 if failures else 0)
