@@ -123,6 +123,7 @@ void TextureViewer::draw(const TextureRef& t, float depthNear, float depthFar, c
     glUniform1i(loc("u_slice"), clampedSlice(t, s, mip));
     glUniform1i(loc("u_axis"), std::clamp(s.axis, 0, 2));
     glUniform1i(loc("u_checker"), s.checker);
+    glUniform1i(loc("u_tonemap"), s.tonemap);
     glUniform2f(loc("u_canvasOrigin"), float(rect.x), float(rect.y));
     glUniform2f(loc("u_canvasSize"), canvas.x, canvas.y);
     const glm::vec2 center = effectiveCenter(s, plane);
@@ -206,6 +207,7 @@ void TextureViewer::window(const run::NamedTexture& nt, bool* open) {
     ImGui::DragFloatRange2("range", &s.rangeMin, &s.rangeMax, std::max(1e-4f, (s.rangeMax - s.rangeMin) * 0.005f), 0, 0, "%.5g", "%.5g");
     if (s.channel != 0) ImGui::Checkbox("false colour", &s.falseColor), ImGui::SameLine();
     ImGui::Checkbox("alpha checkerboard", &s.checker);
+    if (s.channel == 0) ImGui::SameLine(), ImGui::Checkbox("tonemap", &s.tonemap);
     if (depthPlanes) {
         ImGui::SameLine();
         ImGui::Checkbox("depth in metres", &s.linearizeDepth);

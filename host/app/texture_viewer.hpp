@@ -26,6 +26,7 @@ struct ViewSettings {
     bool falseColor = true;       // one channel through a colour map
     bool linearizeDepth = true;   // depth with declared planes: metres
     bool checker = false;         // blend over a checkerboard by alpha
+    bool tonemap = false;         // RGB radiance through ACES + gamma, as composite shows it
     int mip = 0;
     int axis = 2;                 // 3D: 0 x, 1 y, 2 z
     int slice = -1;               // 3D: texel along the axis; -1 = the middle

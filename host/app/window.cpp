@@ -19,6 +19,7 @@
 #include "graph/pipeline.hpp"
 
 #include "app/app.hpp"
+#include "app/compare_view.hpp"
 #include "app/context.hpp"
 #include "app/texture_viewer.hpp"
 #include "kiln/image_io.hpp"
@@ -144,8 +145,16 @@ struct WindowState {
     bool draggingTumbler = false;
     sim::DragMode dragMode = sim::DragMode::Translate;
     double lastX = 0, lastY = 0;
+    // Where the left button went down (the callback sees it when it happens): a slow
+    // frame may poll the button only after the cursor has moved on, and what the press
+    // grabs (the compare line, a tumbler) is decided where it was pressed.
+    bool pressPending = false;
+    double pressX = 0, pressY = 0;
+    double eventX = 0, eventY = 0;  // the cursor as of the last motion event handled
+                                    // (glfwGetCursorPos is the pointer now, later events included)
     glm::ivec4 image{0};              // where the image is, window pixels from the top left
     TextureViewer viewer;
+    CompareView compare;
     PipelineEditor editor;
     // Int parameter values being dragged (applied on release), by "pass.param".
     std::map<std::string, ParamValue> pendingInts;
@@ -220,6 +229,7 @@ void pipelineSwitcher(WindowState& state) {
                 std::string errors;
                 if (app.runtime().loadPipeline(p, errors)) {
                     state.editor.error.clear();  // live reload follows runtime().pipelineFile()
+                    if (name == "compare.json") state.compare.on = true;
                 } else {
                     state.editor.error = errors;  // the running pipeline stays
                 }
@@ -238,6 +248,9 @@ void panelPasses(WindowState& state) {
     ImGui::SameLine();
     if (ImGui::SmallButton("graph")) state.showGraph = !state.showGraph;
     state.probe.item("show-graph");
+    ImGui::SameLine();
+    if (ImGui::SmallButton("compare")) state.compare.on = !state.compare.on;
+    state.probe.item("show-compare");
     if (ImGui::BeginTable("passes", 4, ImGuiTableFlags_RowBg | ImGuiTableFlags_BordersInnerV | ImGuiTableFlags_SizingFixedFit)) {
         ImGui::TableSetupColumn("pass", ImGuiTableColumnFlags_WidthStretch);
         ImGui::TableSetupColumn("state");
@@ -341,6 +354,7 @@ void panelScene(WindowState& state) {
 void panelGraph(WindowState& state, bool* open) {
     App& app = *state.app;
     const graph::Plan* plan = app.runtime().plan();
+    ImGui::SetNextWindowPos(ImVec2(float(state.image.x) + 8, float(state.image.y) + 8), ImGuiCond_FirstUseEver);
     ImGui::SetNextWindowSize(ImVec2(640, 320), ImGuiCond_FirstUseEver);
     if (!ImGui::Begin("Graph", open) || !plan) {
         ImGui::End();
@@ -429,6 +443,16 @@ void drawSidebar(WindowState& state) {
     if (ImGui::Begin("Scene")) panelScene(state);
     ImGui::End();
     if (state.showGraph) panelGraph(state, &state.showGraph);
+    if (state.compare.on) {
+        state.compare.panel(app, ImGui::GetTime(), {state.image.x + 8, state.image.y + 8}, [&](const std::string& id) { state.probe.item(id); });
+        // The line, over the image; drag it (handleMouse).
+        const float x = float(state.image.x) + state.compare.split * float(state.image.z);
+        ImDrawList* fg = ImGui::GetForegroundDrawList();
+        fg->AddLine(ImVec2(x, float(state.image.y)), ImVec2(x, float(state.image.y + state.image.w)), IM_COL32(255, 255, 255, 220), 2.0f);
+        fg->AddText(ImVec2(x - 16, float(state.image.y) + 4), IM_COL32_WHITE, "A");
+        fg->AddText(ImVec2(x + 8, float(state.image.y) + 4), IM_COL32_WHITE, "B");
+        if (state.probe.on()) state.probe.widgets["compare-line"] = {x - 2, state.image.y, x + 2, state.image.y + state.image.w};
+    }
     if (state.showTexture && !app.viewed.empty()) {
         for (auto& t : app.runtime().textures())
             if (t.pass + "." + t.name == app.viewed) {
@@ -466,7 +490,8 @@ void drawImage(WindowState& state, int fbW, int fbH) {
         s.zoom = 0.0f, s.center = glm::vec2(-1.0f);
     }
     const glm::ivec4 rect(state.image.x, fbH - state.image.y - state.image.w, state.image.z, state.image.w);
-    state.viewer.draw(named.ref, named.depthNear, named.depthFar, s, rect);
+    if (state.compare.on) state.compare.draw(state.viewer, app, rect);
+    else state.viewer.draw(named.ref, named.depthNear, named.depthFar, s, rect);
 }
 
 void installCallbacks(GLFWwindow* window) {
@@ -474,6 +499,16 @@ void installCallbacks(GLFWwindow* window) {
         if (ImGui::GetIO().WantCaptureMouse) return;
         auto* s = static_cast<WindowState*>(glfwGetWindowUserPointer(w));
         s->app->camera().distance = std::clamp(s->app->camera().distance * float(std::pow(0.9, dy)), 1.5f, 10.0f);
+    });
+    glfwSetCursorPosCallback(window, [](GLFWwindow* w, double x, double y) {
+        auto* s = static_cast<WindowState*>(glfwGetWindowUserPointer(w));
+        s->eventX = x, s->eventY = y;
+    });
+    glfwSetMouseButtonCallback(window, [](GLFWwindow* w, int button, int action, int) {
+        if (button != GLFW_MOUSE_BUTTON_LEFT || action != GLFW_PRESS) return;
+        auto* s = static_cast<WindowState*>(glfwGetWindowUserPointer(w));
+        s->pressX = s->eventX, s->pressY = s->eventY;
+        s->pressPending = true;
     });
     glfwSetKeyCallback(window, [](GLFWwindow* w, int key, int, int action, int) {
         if (action != GLFW_PRESS || ImGui::GetIO().WantCaptureKeyboard) return;
@@ -495,9 +530,26 @@ void handleMouse(GLFWwindow* window, WindowState& state) {
     double x, y;
     glfwGetCursorPos(window, &x, &y);
     const bool down = glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS;
+    if (down && state.pressPending && !state.dragging && !state.compare.dragging) {
+        // Start from where the press happened; this frame's motion follows.
+        state.lastX = state.pressX, state.lastY = state.pressY;
+        x = state.pressX, y = state.pressY;
+    }
+    state.pressPending = false;
     const bool inImage = x >= state.image.x && y >= state.image.y && x < state.image.x + state.image.z &&
                          y < state.image.y + state.image.w;
     auto& sim = app.scene().sim();
+    // The compare view's line: grabbed within 6 pixels, dragged across the image.
+    CompareView& cmp = state.compare;
+    const double lineX = state.image.x + cmp.split * state.image.z;
+    if (cmp.on && down && (cmp.dragging || (!state.dragging && inImage && std::abs(x - lineX) <= 6 &&
+                                            !ImGui::GetIO().WantCaptureMouse))) {
+        cmp.dragging = true;
+        cmp.split = std::clamp(float((x - state.image.x) / std::max(1, state.image.z)), 0.0f, 1.0f);
+        state.lastX = x, state.lastY = y;
+        return;
+    }
+    if (!down) cmp.dragging = false;
     if (down && (state.dragging || (inImage && !ImGui::GetIO().WantCaptureMouse))) {
         glm::vec3 origin, dir;
         app.camera().rayThrough(x - state.image.x, y - state.image.y, state.image.z, state.image.w, origin, dir);
@@ -555,6 +607,10 @@ nlohmann::json probeState(const WindowState& state, uint64_t frame) {
                         {"value", {r->value.r, r->value.g, r->value.b, r->value.a}}};
     }
     if (const auto& f = state.viewer.lastFit()) j["fit"] = {f->min, f->max};
+    j["compare"] = {{"on", state.compare.on}, {"split", state.compare.split}};
+    if (const auto& e = state.compare.errors())
+        j["compare"]["errors"] = {{"rmse", e->rmse}, {"rel_mse", e->relMse}, {"psnr", e->psnr}, {"ssim", e->ssim},
+                                  {"reference_paths", state.compare.referenceSamples()}};
     if (const graph::Plan* plan = app.runtime().plan()) {
         nlohmann::json passes = nlohmann::json::object();
         for (auto& p : plan->passes) {
@@ -600,6 +656,7 @@ int runWindow(const Options& o) {
     state.probe.path = o.uiProbe;
     state.mainShowsSelection = !o.view.empty();
     state.showTexture = !o.view.empty();
+    state.compare.on = fs::path(o.pipeline).filename() == "compare.json";
     state.autoScale = o.budgetMs > 0;
     state.budgetMs = o.budgetMs > 0 ? float(o.budgetMs) : state.budgetMs;
     if (!state.viewer.init(app.runtime().shaders(), error)) log::error(error);

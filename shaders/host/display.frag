@@ -4,6 +4,8 @@
 // value readout reports. Channel selection, a range remap, false colour for one
 // channel, depth linearised with the producing camera's planes, a mip level, a slice
 // of a 3D texture, and a checkerboard under alpha.
+#include "common/tonemap.glsl"
+
 out vec4 o_color;
 layout(binding = 0) uniform sampler2D u_tex2d;
 layout(binding = 1) uniform sampler3D u_tex3d;
@@ -18,6 +20,7 @@ uniform int u_mip;
 uniform int u_slice;         // 3D: texel index along u_axis
 uniform int u_axis;          // 3D: 0 x, 1 y, 2 z
 uniform bool u_checker;      // blend over a checkerboard by alpha
+uniform bool u_tonemap;      // radiance: ACES + gamma 2.2 as composite shows it, then the range
 // Screen → texel: texel = (gl_FragCoord.xy - u_canvasOrigin - u_canvasSize / 2) / u_zoom + u_center
 // (TextureViewer::texelAt is the same mapping for the cursor).
 uniform vec2 u_canvasOrigin;
@@ -70,7 +73,7 @@ void main() {
     float span = max(u_range.y - u_range.x, 1e-20);
     vec3 c;
     if (u_channel == 0) {
-        c = (v.rgb - u_range.x) / span;
+        c = ((u_tonemap ? displayEncode(v.rgb, kTonemapAces, 2.2) : v.rgb) - u_range.x) / span;
     } else {
         float s = (v[u_channel - 1] - u_range.x) / span;
         c = u_falseColor ? turbo(s) : vec3(s);

@@ -198,6 +198,28 @@ try:
     p = wait_for(lambda p: p["pipeline"].endswith("voxels.json"), "voxels.json running")
     check(not p["errors"] and not p["editor_error"], "voxels.json runs without errors: %s %s" % (p["errors"], p["editor_error"]))
     screenshot("voxels.png")
+
+    # 8. The compare view: compare.json turns it on with figures of composite.hdr
+    #    against the reference; the line follows a drag.
+    click("pipeline-switcher")
+    wait_for(lambda p: "pipeline:compare.json" in p["widgets"], "the pipeline list")
+    click("pipeline:compare.json")
+    p = wait_for(lambda p: p["pipeline"].endswith("compare.json") and "errors" in p["compare"] and
+                 p["compare"]["errors"]["reference_paths"] >= 8, "compare figures", 300)
+    e = p["compare"]["errors"]
+    check(p["compare"]["on"] and 0 < e["rmse"] < 10 and 0 < e["ssim"] <= 1 and e["reference_paths"] >= 8,
+          "compare.json shows RMSE %.4g, SSIM %.4f against a reference of %d paths" % (e["rmse"], e["ssim"], e["reference_paths"]))
+    ix, iy, iw, ih = p["image"]
+    x, _ = centre("compare-line")
+    y = iy + ih - 16  # below the texture window, which is open at the top right
+    sh("xdotool", "mousemove", "--window", WINDOW, str(x), str(y), "mousedown", "1")
+    for step in range(1, 6):
+        sh("xdotool", "mousemove", "--window", WINDOW, str(int(x - step * (x - (ix + iw // 4)) / 5)), str(y))
+        frames_later(1)
+    sh("xdotool", "mouseup", "1")
+    p = wait_for(lambda p: abs(p["compare"]["split"] - 0.25) < 0.03, "the line at a quarter")
+    check(True, "dragging the compare line moves it to %.3f" % p["compare"]["split"])
+    screenshot("compare.png")
 finally:
     kiln.terminate()
     try:
