@@ -166,6 +166,8 @@ struct WindowState {
     float budgetMs = 100.0f;
     double frameMs = 0.0;             // smoothed wall time per frame
     double lastScaleChange = 0.0;
+    double msBeforeDecrease = 0.0;    // frame time before the last step down (0: none pending)
+    float scaleFloor = 0.125f;        // below this, fewer pixels stopped buying time
     std::vector<std::string> pipelines;  // *.json beside the running pipeline
 };
 
@@ -344,7 +346,7 @@ void panelScene(WindowState& state) {
     ImGui::Checkbox("resolution follows the budget", &state.autoScale);
     if (ImGui::IsItemHovered()) ImGui::SetTooltip("lowers the render resolution while frames take longer than the budget");
     ImGui::SetNextItemWidth(120);
-    ImGui::SliderFloat("budget ms", &state.budgetMs, 16.0f, 500.0f, "%.0f");
+    if (ImGui::SliderFloat("budget ms", &state.budgetMs, 16.0f, 500.0f, "%.0f")) state.scaleFloor = 0.125f;
     if (!state.autoScale) ImGui::SliderFloat("resolution scale", &state.renderScale, 0.125f, 1.0f, "%.3f");
     else ImGui::Text("resolution scale %.3f", state.renderScale);
     ImGui::TextDisabled("drag a tumbler: low to move it, high to tilt it");
@@ -370,6 +372,7 @@ void panelGraph(WindowState& state, bool* open) {
     std::map<std::string, bool> ran;
     for (auto& r : app.runtime().stats()) ran[r.id] = r.ranThisFrame;
 
+    ImGui::TextDisabled("green ran, blue skipped (nothing it reads changed), grey culled, red disabled; click to select");
     const ImVec2 nodeSize(150, 46), gap(60, 18);
     const ImVec2 origin = ImGui::GetCursorScreenPos();
     auto nodePos = [&](size_t i) {
@@ -403,7 +406,6 @@ void panelGraph(WindowState& state, bool* open) {
         state.probe.item("graph-node:" + p.id);
         ImGui::PopID();
     }
-    ImGui::TextDisabled("green ran, blue skipped (nothing it reads changed), grey culled, red disabled; click to select");
     ImGui::End();
 }
 
@@ -576,13 +578,28 @@ void handleMouse(GLFWwindow* window, WindowState& state) {
     state.lastX = x, state.lastY = y;
 }
 
-// The resolution budget: at most one change a second, in steps of 0.8 / 1.25, so a
-// single slow frame (a shader rebuild) does not halve the resolution.
+// The resolution budget: steps of 0.8 / 1.25, at most one a second (and six frames), so
+// a single slow frame (a shader rebuild) does not halve the resolution.
 void followBudget(WindowState& state, double now) {
     // The first seconds build every program: not what the scene costs.
-    if (!state.autoScale || now < 3.0 || now - state.lastScaleChange < 1.0) return;
-    if (state.frameMs > state.budgetMs * 1.2 && state.renderScale > 0.125f) {
-        state.renderScale = std::max(0.125f, state.renderScale * 0.8f);
+    // Six frames between changes, so the smoothed frame time has followed the last one.
+    if (!state.autoScale || now < 3.0 || now - state.lastScaleChange < std::max(1.0, 6e-3 * state.frameMs)) return;
+    // A step down that did not save 5 % of the frame: what is left is resolution-independent
+    // work (shadow map, voxels); go back up a step and stay there.
+    if (state.msBeforeDecrease > 0.0) {
+        const bool helped = state.frameMs < state.msBeforeDecrease * 0.95;
+        state.msBeforeDecrease = 0.0;
+        // (Only at half resolution and below: above, a noisy frame time is no reason to stop.)
+        if (!helped && state.renderScale <= 0.5f) {
+            state.renderScale = std::min(1.0f, state.renderScale * 1.25f);
+            state.scaleFloor = state.renderScale;
+            state.lastScaleChange = now;
+            return;
+        }
+    }
+    if (state.frameMs > state.budgetMs * 1.2 && state.renderScale > state.scaleFloor) {
+        state.msBeforeDecrease = state.frameMs;
+        state.renderScale = std::max(state.scaleFloor, state.renderScale * 0.8f);
         state.lastScaleChange = now;
     } else if (state.frameMs < state.budgetMs * 0.5 && state.renderScale < 1.0f) {
         state.renderScale = std::min(1.0f, state.renderScale * 1.25f);
