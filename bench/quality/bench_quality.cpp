@@ -14,7 +14,10 @@
 //    Per setting: GPU ms per pass (timer queries, medians over --frames with every pass
 //    running), and the errors of composite.hdr (radiance before bloom and tonemap)
 //    against the reference: RMSE, relative MSE, SSIM, PSNR; emitters (pixels the
-//    G-buffer marks emissive) masked out.
+//    G-buffer marks emissive) masked out. Also the relative MSE of the indirect part
+//    alone (total − direct: the setting run again with composite.indirect_strength 0,
+//    the reference's own `direct` output) and per region of the box (floor, walls,
+//    ceiling, objects; from the G-buffer depth's world position).
 // 4. Marks the Pareto front over (total GPU ms, relative MSE): settings no other
 //    setting beats on both; plots every setting, the front and the default
 //    (DIR/quality.png, log-log).
@@ -130,7 +133,7 @@ bool fail(const std::string& message) {
 }
 
 // The reference radiance, from the cache or rendered now.
-bool reference(app::App& app, const Args& args, FloatImage& out) {
+bool reference(app::App& app, const Args& args, FloatImage& out, FloatImage& direct) {
     const std::string sceneText = slurp(args.scene);
     uint64_t key = fnv1a(sceneText);
     const double values[] = {args.time, double(args.width), double(args.height), double(args.spp)};
@@ -138,8 +141,11 @@ bool reference(app::App& app, const Args& args, FloatImage& out) {
     char name[64];
     std::snprintf(name, sizeof name, "reference-%016llx.exr", static_cast<unsigned long long>(key));
     const fs::path cache = fs::path(args.outDir) / "cache" / name;
+    fs::path directCache = cache;
+    directCache.replace_extension(".direct.exr");
     std::string error;
-    if (fs::exists(cache) && readExr(cache.string(), out, error)) {
+    if (fs::exists(cache) && fs::exists(directCache) && readExr(cache.string(), out, error) &&
+        readExr(directCache.string(), direct, error)) {
         std::printf("reference: %s (cached)\n", cache.string().c_str());
         return true;
     }
@@ -161,12 +167,40 @@ bool reference(app::App& app, const Args& args, FloatImage& out) {
     const TextureRef* t = app.runtime().findTexture("reference", "radiance");
     if (!t) return fail("the reference pass produced no texture");
     out = readTexture(t->id, t->target, t->format, t->width, t->height);
+    const TextureRef* d = app.runtime().findTexture("reference", "direct");
+    if (!d) return fail("the reference pass produced no direct texture");
+    direct = readTexture(d->id, d->target, d->format, d->width, d->height);
     if (out.at(0, 0)[3] != float(args.spp)) return fail("the reference stopped early: " + std::to_string(out.at(0, 0)[3]) + " paths");
     fs::create_directories(cache.parent_path());
-    if (!writeExr(cache.string(), out, error)) return fail(error);
+    if (!writeExr(cache.string(), out, error) || !writeExr(directCache.string(), direct, error)) return fail(error);
     std::printf("reference: %d paths/px in %.1f s, cached as %s\n", args.spp,
                 std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), cache.string().c_str());
     return true;
+}
+
+// Parts of the box a pixel shows, from the world position of its depth: the box is
+// [-1, 1]³ (the sim's walls), everything inside it an object (tumblers, balls).
+enum Region { kFloor, kWalls, kCeiling, kObjects, kRegionCount };
+const char* const kRegionNames[kRegionCount] = {"floor", "walls", "ceiling", "objects"};
+
+std::vector<int> regionsOf(const app::App& app, const FloatImage& depth) {
+    const glm::mat4 invViewProj = glm::inverse(app.camera().projection(float(depth.width) / float(depth.height)) *
+                                               app.camera().view());
+    std::vector<int> region(size_t(depth.width) * depth.height, -1);
+    constexpr float kOnWall = 0.995f;  // within 5 mm of a wall plane
+    for (int y = 0; y < depth.height; ++y)
+        for (int x = 0; x < depth.width; ++x) {
+            const float d = depth.at(x, y)[0];
+            if (d >= 1.0f) continue;  // nothing drawn
+            glm::vec4 p = invViewProj * glm::vec4((x + 0.5f) / depth.width * 2 - 1, (y + 0.5f) / depth.height * 2 - 1, d * 2 - 1, 1);
+            p /= p.w;
+            int r = kObjects;
+            if (p.y < -kOnWall) r = kFloor;
+            else if (p.y > kOnWall) r = kCeiling;
+            else if (std::abs(p.x) > kOnWall || p.z < -kOnWall) r = kWalls;
+            region[size_t(y) * depth.width + x] = r;
+        }
+    return region;
 }
 
 struct Result {
@@ -174,15 +208,18 @@ struct Result {
     std::vector<std::pair<std::string, double>> passMs;  // plan order
     double totalMs = 0;
     metrics::Errors errors;
+    double indirectRelMse = 0;
+    double regionRelMse[kRegionCount] = {};
     bool pareto = false;
 };
 
-bool measure(app::App& app, const Args& args, const Setting& setting, const FloatImage& ref, Result& r) {
+bool measure(app::App& app, const Args& args, const Setting& setting, const FloatImage& ref, const FloatImage& refDirect,
+             Result& r) {
     std::string text, error;
     if (!applyOverrides(slurp(args.pipeline), setting.overrides, text, error) ||
         !app.runtime().loadPipelineText(text, args.pipeline, error))
         return fail(setting.label + ": " + error);
-    app.runtime().setRequested({"composite.hdr", "gbuffer.emissive"});
+    app.runtime().setRequested({"composite.hdr", "gbuffer.emissive", "gbuffer.depth"});
     app.runtime().alwaysRun = true;
     for (int f = 0; f < 2; ++f) app.frame();  // compile, allocate
     glFinish();
@@ -209,6 +246,21 @@ bool measure(app::App& app, const Args& args, const Setting& setting, const Floa
             if (e[0] + e[1] + e[2] > 0.0f) mask[size_t(y) * image.width + x] = 0;
         }
     r.errors = metrics::compare(image, ref, mask);
+
+    const TextureRef* depth = app.runtime().findTexture("gbuffer", "depth");
+    if (!depth) return fail(setting.label + ": the pipeline has no gbuffer.depth");
+    const std::vector<int> region = regionsOf(app, readTexture(depth->id, depth->target, depth->format, depth->width, depth->height));
+    for (int k = 0; k < kRegionCount; ++k) {
+        metrics::Mask m = mask;
+        for (size_t i = 0; i < m.size(); ++i) m[i] = m[i] && region[i] == k;
+        r.regionRelMse[k] = metrics::relativeMse(image, ref, m);
+    }
+    // The indirect part: the same frame without composite's indirect term.
+    if (!app.runtime().setParam("composite", "indirect_strength", 0.0f, error)) return fail(setting.label + ": " + error);
+    app.frame();
+    glFinish();
+    const FloatImage direct = readTexture(hdr->id, hdr->target, hdr->format, hdr->width, hdr->height);
+    r.indirectRelMse = metrics::relativeMse(metrics::difference(image, direct), metrics::difference(ref, refDirect), mask);
     return std::isfinite(r.errors.rmse) && std::isfinite(r.errors.relMse) && std::isfinite(r.errors.ssim)
                ? true
                : fail(setting.label + ": an error metric is not finite");
@@ -250,12 +302,12 @@ int main(int argc, char** argv) {
                 context->description().c_str(), args.scene.c_str(), app.scene().time(), args.width, args.height,
                 args.spp, args.frames);
 
-    FloatImage ref;
-    if (!reference(app, args, ref)) return 1;
+    FloatImage ref, refDirect;
+    if (!reference(app, args, ref, refDirect)) return 1;
     std::vector<Result> results;
     for (auto& s : settings) {
         Result r;
-        if (!measure(app, args, s, ref, r)) return 1;
+        if (!measure(app, args, s, ref, refDirect, r)) return 1;
         results.push_back(std::move(r));
     }
     markPareto(results);
@@ -263,16 +315,22 @@ int main(int argc, char** argv) {
     fs::create_directories(args.outDir);
     const std::string csvPath = (fs::path(args.outDir) / "quality.csv").string();
     std::ofstream csv(csvPath);
-    csv << "setting,total_gpu_ms,rmse,rel_mse,ssim,psnr,pixels,pareto,pass_ms\n";
-    std::printf("%-36s %10s %10s %10s %8s %8s  %s\n", "setting", "gpu ms", "RMSE", "relMSE", "SSIM", "PSNR", "front");
+    csv << "setting,total_gpu_ms,rmse,rel_mse,ssim,psnr,pixels,pareto,rel_mse_indirect";
+    for (const char* name : kRegionNames) csv << ",rel_mse_" << name;
+    csv << ",pass_ms\n";
+    std::printf("%-36s %9s %9s %9s %7s %7s %9s  %-31s %s\n", "setting", "gpu ms", "RMSE", "relMSE", "SSIM", "PSNR",
+                "indirect", "relMSE floor/walls/ceil/objects", "front");
     for (auto& r : results) {
-        std::printf("%-36s %10.2f %10.5f %10.5f %8.4f %8.2f  %s\n", r.label.c_str(), r.totalMs, r.errors.rmse,
-                    r.errors.relMse, r.errors.ssim, r.errors.psnr, r.pareto ? "*" : "");
+        std::printf("%-36s %9.2f %9.5f %9.5f %7.4f %7.2f %9.5f  %7.4f %7.4f %7.4f %7.4f  %s\n", r.label.c_str(), r.totalMs,
+                    r.errors.rmse, r.errors.relMse, r.errors.ssim, r.errors.psnr, r.indirectRelMse, r.regionRelMse[0],
+                    r.regionRelMse[1], r.regionRelMse[2], r.regionRelMse[3], r.pareto ? "*" : "");
         std::string passes;
         for (auto& [id, ms] : r.passMs) passes += (passes.empty() ? "" : " ") + id + "=" + std::to_string(ms);
         csv << '"' << r.label << "\"," << r.totalMs << ',' << r.errors.rmse << ',' << r.errors.relMse << ','
-            << r.errors.ssim << ',' << r.errors.psnr << ',' << r.errors.pixels << ',' << (r.pareto ? 1 : 0) << ",\""
-            << passes << "\"\n";
+            << r.errors.ssim << ',' << r.errors.psnr << ',' << r.errors.pixels << ',' << (r.pareto ? 1 : 0) << ','
+            << r.indirectRelMse;
+        for (double v : r.regionRelMse) csv << ',' << v;
+        csv << ",\"" << passes << "\"\n";
     }
     LogLogPlot plot{"GPU ms against error vs the reference", "total GPU ms per frame",
                     "relative MSE (emitters masked)", {}};

@@ -41,6 +41,7 @@ public:
     const Runtime& runtime() const { return runtime_; }
     scene::LiveScene& scene() { return scene_; }
     OrbitCamera& camera() { return camera_; }
+    const OrbitCamera& camera() const { return camera_; }
     LiveReload& live() { return live_; }
     // The seed given on the command line, if any (a scene reload keeps it).
     std::optional<uint64_t> seedOverride() const;

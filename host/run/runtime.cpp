@@ -253,6 +253,16 @@ std::vector<uint64_t> Runtime::runKey(const graph::PlannedPass& planned, const P
 }
 
 void Runtime::renderFrame(const SceneView& view, const SceneDraw& scene, const FrameInfo& frameIn) {
+    const auto start = std::chrono::steady_clock::now();
+    cost_ = {};
+    struct Done {  // on every return
+        Runtime& rt;
+        std::chrono::steady_clock::time_point start;
+        ~Done() {
+            rt.cost_.frameMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+            rt.lastCost_ = rt.cost_;
+        }
+    } done{*this, start};
     FrameInfo frame = frameIn;
     frame.outputWidth = options_.width;
     frame.outputHeight = options_.height;
@@ -294,7 +304,9 @@ void Runtime::runPass(size_t i, const FrameResources& shared, const SceneView& v
         }
         t.timer.end();
     }
-    t.addCpu(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - cpuStart).count());
+    const double cpuMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - cpuStart).count();
+    t.addCpu(cpuMs);
+    cost_.passesMs += cpuMs;
 
     if (ctx.failed()) {
         slot.lastRunKey.reset();

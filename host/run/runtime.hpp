@@ -65,6 +65,13 @@ public:
     void resetTimings();
     // Runs every pass every frame regardless of versions (timing runs).
     bool alwaysRun = false;
+    // The CPU cost of the last renderFrame: all of it, and the part inside the passes'
+    // execute(); the rest is the graph's own (version checks, state resets, timer
+    // queries, uniform upload, bookkeeping).
+    struct FrameCost {
+        double frameMs = 0.0, passesMs = 0.0;
+    };
+    FrameCost lastFrameCost() const { return lastCost_; }
 
     // The graph output of the last frame (a colour 2D texture), or null.
     const TextureRef* outputTexture() const;
@@ -113,6 +120,7 @@ private:
     std::optional<graph::Plan> plan_;
     std::string pipelineText_, pipelineFile_;
     std::optional<graph::PipelineDesc> desc_;
+    FrameCost lastCost_, cost_;
     std::vector<std::string> requested_;
     std::vector<std::unique_ptr<PassSlot>> slots_;  // parallel to plan_->passes
     gl::Buffer frameUniforms_;

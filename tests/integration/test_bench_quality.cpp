@@ -21,13 +21,14 @@ TEST_CASE("kiln-bench-quality: a tiny sweep writes one finite CSV row per settin
     std::istringstream csv(slurp(out + "/quality.csv"));
     std::string line;
     std::getline(csv, line);
-    CHECK(line == "setting,total_gpu_ms,rmse,rel_mse,ssim,psnr,pixels,pareto,pass_ms");
+    CHECK(line == "setting,total_gpu_ms,rmse,rel_mse,ssim,psnr,pixels,pareto,rel_mse_indirect,rel_mse_floor,rel_mse_walls,"
+                  "rel_mse_ceiling,rel_mse_objects,pass_ms");
     int rows = 0, front = 0;
     while (std::getline(csv, line)) {
         ++rows;
-        // "label",ms,rmse,relmse,ssim,psnr,pixels,pareto,"passes"
+        // "label",ms,rmse,relmse,ssim,psnr,pixels,pareto,indirect,floor,walls,ceiling,objects,"passes"
         std::istringstream cells(line.substr(line.find("\",") + 2));
-        double v[7];
+        double v[12];
         char comma;
         for (double& x : v) cells >> x >> comma;
         for (double x : v) CHECK(std::isfinite(x));
@@ -36,6 +37,9 @@ TEST_CASE("kiln-bench-quality: a tiny sweep writes one finite CSV row per settin
         CHECK((v[3] > -1.0 && v[3] <= 1.0));  // SSIM
         CHECK(v[5] > 32 * 32 / 2);          // most pixels counted (emitters masked)
         front += v[6] == 1.0;
+        // Every part of the box is in view and has an error of its own (the emitter-free
+        // ceiling around the lamp included), and so has the indirect part.
+        for (int k = 7; k < 12; ++k) CHECK(v[k] > 0.0);
         CHECK(line.find("cone_trace=") != std::string::npos);
     }
     CHECK(rows == 3);  // default + 2 sweep values

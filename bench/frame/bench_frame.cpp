@@ -1,0 +1,187 @@
+// kiln-bench-skip and kiln-bench-overhead — what skipping saves and what the graph
+// costs, measured in one run each (commands, not tests: they print a table and write CSV).
+//
+//   kiln-bench-skip     [--size WxH] [--frames N] [--out DIR]
+//   kiln-bench-overhead [--size WxH] [--frames N] [--out DIR]
+//
+// skip: the default pipeline and scene in five situations, one after the other in one
+// process: moving; paused (nothing changes: every pass may skip); moving without
+// fireballs (no particles, no moving emitters); moving with bloom culled (composite does
+// not read it); moving with bloom disabled. Per situation: each pass's median GPU and
+// CPU ms over the frames it ran, how often it ran, and the median wall time per frame
+// (with a glFinish, what a user waits for), and the ratio to "moving".
+//
+// overhead: the CPU time of Runtime::renderFrame against the part inside the passes'
+// execute(): the rest is the graph's own (version checks, state resets, timer queries,
+// uniform upload, bookkeeping), moving and paused, as a share of the frame.
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+
+#include <nlohmann/json.hpp>
+
+#include "app/app.hpp"
+#include "app/context.hpp"
+#include "kiln/log.hpp"
+#include "support/bench_support.hpp"
+
+namespace fs = std::filesystem;
+using namespace kiln;
+using namespace kiln::bench;
+using Json = nlohmann::json;
+
+namespace {
+
+struct Args {
+    int width = 256, height = 256, frames = 30;
+    std::string outDir = "bench-out";
+};
+
+Args parseArgs(int argc, char** argv, const char* name) {
+    Args a;
+    for (int i = 1; i < argc; ++i) {
+        const std::string arg = argv[i];
+        const bool hasValue = i + 1 < argc;
+        if (arg == "--size" && hasValue && std::sscanf(argv[i + 1], "%dx%d", &a.width, &a.height) == 2) ++i;
+        else if (arg == "--frames" && hasValue) a.frames = std::max(3, std::atoi(argv[++i]));
+        else if (arg == "--out" && hasValue) a.outDir = argv[++i];
+        else {
+            std::fprintf(stderr, "%s: error: unknown or incomplete option \"%s\"\nusage: %s [--size WxH] [--frames N] [--out DIR]\n",
+                         name, arg.c_str(), name);
+            std::exit(2);
+        }
+    }
+    return a;
+}
+
+struct Situation {
+    std::string label;
+    std::string pipelineText, sceneFile;
+    bool paused = false;
+};
+
+struct PassRowOut {
+    std::string id, state;
+    double gpuMs = 0, cpuMs = 0;
+    int ran = 0, skipped = 0;
+};
+
+struct Outcome {
+    std::string label;
+    double frameMs = 0, hostMs = 0, passesMs = 0;  // medians
+    std::vector<PassRowOut> passes;
+};
+
+// `frames` frames of one situation after 3 to settle (compiles, allocation, a first run
+// after a change), with skipping on as a user runs it.
+Outcome runSituation(app::App& app, const Situation& s, int frames) {
+    std::string error;
+    if (!app.runtime().loadPipelineText(s.pipelineText, s.label, error) || !app.scene().load(s.sceneFile, std::nullopt, error)) {
+        std::fprintf(stderr, "error: %s: %s\n", s.label.c_str(), error.c_str());
+        std::exit(1);
+    }
+    app.paused = false;
+    for (int f = 0; f < 3; ++f) app.frame();
+    app.paused = s.paused;
+    app.frame();  // the paused state's first frame still runs what the last step changed
+    glFinish();
+    app.runtime().resetTimings();
+    std::vector<double> wall, host, passes;
+    for (int f = 0; f < frames; ++f) {
+        const auto start = std::chrono::steady_clock::now();
+        app.frame();
+        glFinish();
+        wall.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+        const auto cost = app.runtime().lastFrameCost();
+        host.push_back(cost.frameMs - cost.passesMs);
+        passes.push_back(cost.passesMs);
+    }
+    app.runtime().collectGpuTimes();
+    Outcome o{s.label, median(wall), median(host), median(passes), {}};
+    for (auto& r : app.runtime().stats())
+        o.passes.push_back({r.id, r.state, r.ranFrames ? r.gpuMedianMs : 0.0, r.ranFrames ? r.cpuMedianMs : 0.0,
+                            r.ranFrames, r.skippedFrames});
+    return o;
+}
+
+std::string withoutFireballs(const std::string& sceneFile, const fs::path& dir) {
+    Json j = Json::parse(slurp(sceneFile));
+    j["fireballs"] = Json::array();
+    const fs::path out = dir / "cornell-no-fireballs.json";
+    std::ofstream(out) << j.dump(2);
+    return out.string();
+}
+
+std::string editedPipeline(const std::string& text, bool cullBloom, bool disableBloom) {
+    Json j = Json::parse(text);
+    for (auto& p : j["passes"]) {
+        if (disableBloom && p["id"] == "bloom") p["enabled"] = false;
+        if (cullBloom && p["id"] == "composite") p["inputs"].erase("bloom");
+    }
+    return j.dump(2);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    const bool overhead = fs::path(argv[0]).filename() == "kiln-bench-overhead";
+    const char* name = overhead ? "kiln-bench-overhead" : "kiln-bench-skip";
+    const Args args = parseArgs(argc, argv, name);
+    std::string error;
+    auto context = app::HeadlessContext::create(false, error);
+    if (!context) {
+        std::fprintf(stderr, "%s: error: %s\n", name, error.c_str());
+        return 1;
+    }
+    log::setMinLevel(log::Level::Warn);
+    fs::create_directories(args.outDir);
+
+    app::Options o;
+    app::applyDefaults(o);
+    o.headless = true, o.live = false, o.width = args.width, o.height = args.height;
+    app::App app;
+    if (!app.init(o, error)) {
+        std::fprintf(stderr, "%s: error: %s\n", name, error.c_str());
+        return 1;
+    }
+    const std::string pipeline = slurp(o.pipeline);
+    std::vector<Situation> situations = {{"moving", pipeline, o.scene, false}, {"paused", pipeline, o.scene, true}};
+    if (!overhead) {
+        situations.push_back({"moving, no fireballs", pipeline, withoutFireballs(o.scene, args.outDir), false});
+        situations.push_back({"moving, bloom culled", editedPipeline(pipeline, true, false), o.scene, false});
+        situations.push_back({"moving, bloom disabled", editedPipeline(pipeline, false, true), o.scene, false});
+    }
+    std::vector<Outcome> outcomes;
+    for (auto& s : situations) outcomes.push_back(runSituation(app, s, args.frames));
+
+    std::printf("%s: %s, %dx%d, medians of %d frames each, one process\n\n", name, context->description().c_str(),
+                args.width, args.height, args.frames);
+    const std::string csvPath = (fs::path(args.outDir) / (overhead ? "overhead.csv" : "skip.csv")).string();
+    std::ofstream csv(csvPath);
+    if (overhead) {
+        csv << "situation,frame_cpu_ms,passes_cpu_ms,graph_cpu_ms,graph_share\n";
+        std::printf("%-10s %14s %14s %14s %8s\n", "situation", "renderFrame ms", "in passes ms", "graph's own ms", "share");
+        for (auto& r : outcomes) {
+            const double total = r.hostMs + r.passesMs, share = total > 0 ? r.hostMs / total : 0.0;
+            std::printf("%-10s %14.3f %14.3f %14.3f %7.1f%%\n", r.label.c_str(), total, r.passesMs, r.hostMs, 100 * share);
+            csv << r.label << ',' << total << ',' << r.passesMs << ',' << r.hostMs << ',' << share << '\n';
+        }
+        std::printf("\n(CPU side of Runtime::renderFrame; the frame's wall time, GPU work included, is in kiln-bench-skip)\n");
+    } else {
+        csv << "situation,pass,state,gpu_ms,cpu_ms,ran,skipped,frame_ms,frame_ratio\n";
+        const double moving = outcomes.front().frameMs;
+        for (auto& r : outcomes) {
+            std::printf("%s: %.3f ms per frame (%.4f of moving)\n", r.label.c_str(), r.frameMs, r.frameMs / moving);
+            for (auto& p : r.passes) {
+                std::printf("    %-12s %-14s gpu %8.3f  cpu %8.3f  ran %3d  skipped %3d\n", p.id.c_str(), p.state.c_str(),
+                            p.gpuMs, p.cpuMs, p.ran, p.skipped);
+                csv << '"' << r.label << "\"," << p.id << ',' << p.state << ',' << p.gpuMs << ',' << p.cpuMs << ','
+                    << p.ran << ',' << p.skipped << ',' << r.frameMs << ',' << r.frameMs / moving << '\n';
+            }
+        }
+    }
+    std::printf("wrote %s\n", csvPath.c_str());
+    return 0;
+}
