@@ -1,8 +1,11 @@
 // kiln-bench-skip and kiln-bench-overhead — what skipping saves and what the graph
 // costs, measured in one run each (commands, not tests: they print a table and write CSV).
 //
-//   kiln-bench-skip     [--size WxH] [--frames N] [--out DIR]
-//   kiln-bench-overhead [--size WxH] [--frames N] [--out DIR]
+//   kiln-bench-skip     [--size WxH] [--frames N] [--repeats R] [--out DIR]
+//   kiln-bench-overhead [--size WxH] [--frames N] [--repeats R] [--out DIR]
+//
+// Each situation is measured in R rounds that visit every situation in turn (a slow
+// minute of a shared machine lands on all of them); figures are medians over rounds.
 //
 // skip: the default pipeline and scene in five situations, one after the other in one
 // process: moving; paused (nothing changes: every pass may skip); moving without
@@ -35,7 +38,7 @@ using Json = nlohmann::json;
 namespace {
 
 struct Args {
-    int width = 256, height = 256, frames = 30;
+    int width = 256, height = 256, frames = 30, repeats = 3;
     std::string outDir = "bench-out";
 };
 
@@ -46,9 +49,10 @@ Args parseArgs(int argc, char** argv, const char* name) {
         const bool hasValue = i + 1 < argc;
         if (arg == "--size" && hasValue && std::sscanf(argv[i + 1], "%dx%d", &a.width, &a.height) == 2) ++i;
         else if (arg == "--frames" && hasValue) a.frames = std::max(3, std::atoi(argv[++i]));
+        else if (arg == "--repeats" && hasValue) a.repeats = std::max(1, std::atoi(argv[++i]));
         else if (arg == "--out" && hasValue) a.outDir = argv[++i];
         else {
-            std::fprintf(stderr, "%s: error: unknown or incomplete option \"%s\"\nusage: %s [--size WxH] [--frames N] [--out DIR]\n",
+            std::fprintf(stderr, "%s: error: unknown or incomplete option \"%s\"\nusage: %s [--size WxH] [--frames N] [--repeats R] [--out DIR]\n",
                          name, arg.c_str(), name);
             std::exit(2);
         }
@@ -71,6 +75,8 @@ struct PassRowOut {
 struct Outcome {
     std::string label;
     double frameMs = 0, hostMs = 0, passesMs = 0;  // medians
+    double simTime = 0;
+    size_t particles = 0, balls = 0;                 // at the end (the same in every situation but the no-fireball one)
     std::vector<PassRowOut> passes;
 };
 
@@ -99,7 +105,8 @@ Outcome runSituation(app::App& app, const Situation& s, int frames) {
         passes.push_back(cost.passesMs);
     }
     app.runtime().collectGpuTimes();
-    Outcome o{s.label, median(wall), median(host), median(passes), {}};
+    Outcome o{s.label, median(wall), median(host), median(passes), app.scene().time(),
+              app.scene().sim().particles().size(), app.scene().sim().balls().size(), {}};
     for (auto& r : app.runtime().stats())
         o.passes.push_back({r.id, r.state, r.ranFrames ? r.gpuMedianMs : 0.0, r.ranFrames ? r.cpuMedianMs : 0.0,
                             r.ranFrames, r.skippedFrames});
@@ -153,11 +160,29 @@ int main(int argc, char** argv) {
         situations.push_back({"moving, bloom culled", editedPipeline(pipeline, true, false), o.scene, false});
         situations.push_back({"moving, bloom disabled", editedPipeline(pipeline, false, true), o.scene, false});
     }
+    std::vector<std::vector<Outcome>> rounds(situations.size());
+    for (int r = 0; r < args.repeats; ++r)
+        for (size_t i = 0; i < situations.size(); ++i) rounds[i].push_back(runSituation(app, situations[i], args.frames));
     std::vector<Outcome> outcomes;
-    for (auto& s : situations) outcomes.push_back(runSituation(app, s, args.frames));
+    for (auto& all : rounds) {
+        Outcome o = all.front();
+        auto med = [&](auto get) {
+            std::vector<double> v;
+            for (auto& x : all) v.push_back(get(x));
+            return median(v);
+        };
+        o.frameMs = med([](const Outcome& x) { return x.frameMs; });
+        o.hostMs = med([](const Outcome& x) { return x.hostMs; });
+        o.passesMs = med([](const Outcome& x) { return x.passesMs; });
+        for (size_t p = 0; p < o.passes.size(); ++p) {
+            o.passes[p].gpuMs = med([&](const Outcome& x) { return x.passes[p].gpuMs; });
+            o.passes[p].cpuMs = med([&](const Outcome& x) { return x.passes[p].cpuMs; });
+        }
+        outcomes.push_back(std::move(o));
+    }
 
-    std::printf("%s: %s, %dx%d, medians of %d frames each, one process\n\n", name, context->description().c_str(),
-                args.width, args.height, args.frames);
+    std::printf("%s: %s, %dx%d, medians of %d frames each over %d rounds, one process\n\n", name,
+                context->description().c_str(), args.width, args.height, args.frames, args.repeats);
     const std::string csvPath = (fs::path(args.outDir) / (overhead ? "overhead.csv" : "skip.csv")).string();
     std::ofstream csv(csvPath);
     if (overhead) {
@@ -173,7 +198,8 @@ int main(int argc, char** argv) {
         csv << "situation,pass,state,gpu_ms,cpu_ms,ran,skipped,frame_ms,frame_ratio\n";
         const double moving = outcomes.front().frameMs;
         for (auto& r : outcomes) {
-            std::printf("%s: %.3f ms per frame (%.4f of moving)\n", r.label.c_str(), r.frameMs, r.frameMs / moving);
+            std::printf("%s: %.3f ms per frame (%.4f of moving); t = %.3f s, %zu balls, %zu particles\n", r.label.c_str(),
+                        r.frameMs, r.frameMs / moving, r.simTime, r.balls, r.particles);
             for (auto& p : r.passes) {
                 std::printf("    %-12s %-14s gpu %8.3f  cpu %8.3f  ran %3d  skipped %3d\n", p.id.c_str(), p.state.c_str(),
                             p.gpuMs, p.cpuMs, p.ran, p.skipped);

@@ -3,7 +3,7 @@
 // writes CSV.
 //
 //   kiln-bench-quality [--pipeline FILE] [--scene FILE] [--time SECONDS] [--size WxH]
-//                      [--spp N] [--frames N] [--sweep PASS.PARAM=V1,V2,...]... [--out DIR]
+//                      [--spp N] [--frames N] [--repeats R] [--sweep PASS.PARAM=V1,V2,...]... [--out DIR]
 //
 // 1. Steps the scene to --time and freezes it.
 // 2. The reference (passes/reference) at --spp paths per pixel, cached as OpenEXR in
@@ -12,7 +12,9 @@
 // 3. The pipeline once as it is ("default") and once per value of each --sweep (one
 //    knob at a time around the default; without --sweep, the documented subset below).
 //    Per setting: GPU ms per pass (timer queries, medians over --frames with every pass
-//    running), and the errors of composite.hdr (radiance before bloom and tonemap)
+//    running; then the median over --repeats rounds, each round visiting every setting
+//    once, so a slow minute of a shared machine lands on all settings alike, not on
+//    the few measured in it), and the errors of composite.hdr (radiance before bloom and tonemap)
 //    against the reference: RMSE, relative MSE, SSIM, PSNR; emitters (pixels the
 //    G-buffer marks emissive) masked out. Also the relative MSE of the indirect part
 //    alone (total − direct: the setting run again with composite.indirect_strength 0,
@@ -58,7 +60,7 @@ struct Args {
     std::string pipeline = std::string(KILN_SOURCE_DIR) + "/pipelines/default.json";
     std::string scene = std::string(KILN_SOURCE_DIR) + "/scenes/cornell.json";
     double time = 0.5;
-    int width = 128, height = 128, spp = 256, frames = 5;
+    int width = 128, height = 128, spp = 256, frames = 5, repeats = 3;
     std::vector<std::string> sweeps;
     std::string outDir = "bench-out";
 };
@@ -96,11 +98,12 @@ Args parseArgs(int argc, char** argv) {
                 usageError("--size " + v + ": expected WxH between 8 and 4096");
         } else if (a == "--spp") args.spp = positive(next());
         else if (a == "--frames") args.frames = positive(next());
+        else if (a == "--repeats") args.repeats = positive(next());
         else if (a == "--sweep") args.sweeps.push_back(next());
         else if (a == "--out") args.outDir = next();
         else if (a == "--help" || a == "-h") {
             std::printf("usage: kiln-bench-quality [--pipeline FILE] [--scene FILE] [--time S] [--size WxH] [--spp N]\n"
-                        "                          [--frames N] [--sweep PASS.PARAM=V1,V2,...]... [--out DIR]\n");
+                        "                          [--frames N] [--repeats R] [--sweep PASS.PARAM=V1,V2,...]... [--out DIR]\n");
             std::exit(0);
         } else usageError("unknown argument \"" + a + "\"");
     }
@@ -298,17 +301,27 @@ int main(int argc, char** argv) {
     if (!app.init(o, error)) return fail(error) ? 0 : 1;
     while (app.scene().time() + 1e-9 < args.time) app.frame();  // to the chosen moment
     app.paused = true;
-    std::printf("device: %s\nscene %s frozen at t = %.3f s, %dx%d, reference %d paths/px, %d timed frames\n\n",
+    std::printf("device: %s\nscene %s frozen at t = %.3f s, %dx%d, reference %d paths/px, %d timed frames x %d rounds\n\n",
                 context->description().c_str(), args.scene.c_str(), app.scene().time(), args.width, args.height,
-                args.spp, args.frames);
+                args.spp, args.frames, args.repeats);
 
     FloatImage ref, refDirect;
     if (!reference(app, args, ref, refDirect)) return 1;
-    std::vector<Result> results;
-    for (auto& s : settings) {
-        Result r;
-        if (!measure(app, args, s, ref, refDirect, r)) return 1;
-        results.push_back(std::move(r));
+    // Errors are deterministic (one round gives them); times are medians over the rounds.
+    std::vector<Result> results(settings.size());
+    std::vector<std::map<std::string, std::vector<double>>> passSamples(settings.size());
+    std::vector<std::vector<double>> totals(settings.size());
+    for (int round = 0; round < args.repeats; ++round)
+        for (size_t i = 0; i < settings.size(); ++i) {
+            Result r;
+            if (!measure(app, args, settings[i], ref, refDirect, r)) return 1;
+            totals[i].push_back(r.totalMs);
+            for (auto& [id, ms] : r.passMs) passSamples[i][id].push_back(ms);
+            if (round == 0) results[i] = std::move(r);
+        }
+    for (size_t i = 0; i < settings.size(); ++i) {
+        results[i].totalMs = median(totals[i]);
+        for (auto& [id, ms] : results[i].passMs) ms = median(passSamples[i][id]);
     }
     markPareto(results);
 
