@@ -3,14 +3,16 @@
 // writes CSV.
 //
 //   kiln-bench-quality [--pipeline FILE] [--scene FILE] [--time SECONDS] [--size WxH]
-//                      [--spp N] [--frames N] [--repeats R] [--sweep PASS.PARAM=V1,V2,...]... [--out DIR]
+//                      [--spp N] [--frames N] [--repeats R] [--sweep PASS.PARAM=V1,V2,...]...
+//                      [--cartesian] [--out DIR]
 //
 // 1. Steps the scene to --time and freezes it.
 // 2. The reference (passes/reference) at --spp paths per pixel, cached as OpenEXR in
 //    DIR/cache/ under a hash of the scene file, time, size and sample count (progress
 //    and ETA on stderr while it renders).
 // 3. The pipeline once as it is ("default") and once per value of each --sweep (one
-//    knob at a time around the default; without --sweep, the documented subset below).
+//    knob at a time around the default, or every combination with --cartesian; without
+//    --sweep, the documented subset below).
 //    Per setting: GPU ms per pass (timer queries, medians over --frames with every pass
 //    running; then the median over --repeats rounds, each round visiting every setting
 //    once, so a slow minute of a shared machine lands on all settings alike, not on
@@ -62,6 +64,7 @@ struct Args {
     double time = 0.5;
     int width = 128, height = 128, spp = 256, frames = 5, repeats = 3;
     std::vector<std::string> sweeps;
+    bool cartesian = false;  // every combination of the sweeps, not one knob at a time
     std::string outDir = "bench-out";
 };
 
@@ -99,11 +102,13 @@ Args parseArgs(int argc, char** argv) {
         } else if (a == "--spp") args.spp = positive(next());
         else if (a == "--frames") args.frames = positive(next());
         else if (a == "--repeats") args.repeats = positive(next());
+        else if (a == "--cartesian") args.cartesian = true;
         else if (a == "--sweep") args.sweeps.push_back(next());
         else if (a == "--out") args.outDir = next();
         else if (a == "--help" || a == "-h") {
             std::printf("usage: kiln-bench-quality [--pipeline FILE] [--scene FILE] [--time S] [--size WxH] [--spp N]\n"
-                        "                          [--frames N] [--repeats R] [--sweep PASS.PARAM=V1,V2,...]... [--out DIR]\n");
+                        "                          [--frames N] [--repeats R] [--sweep PASS.PARAM=V1,V2,...]... [--cartesian]\n"
+                        "                          [--out DIR]\n");
             std::exit(0);
         } else usageError("unknown argument \"" + a + "\"");
     }
@@ -116,17 +121,38 @@ struct Setting {
     std::vector<Override> overrides;
 };
 
+// The default, then either each sweep's values one knob at a time, or (--cartesian)
+// every combination of them.
 std::vector<Setting> settingsOf(const Args& args) {
-    std::vector<Setting> settings{{"default", {}}};
+    std::vector<std::vector<Setting>> axes;
     for (auto& sweep : args.sweeps) {
         Override base;
         std::string error;
         if (!parseOverride(sweep, base, error)) usageError("--sweep " + error);
         std::stringstream values(base.json);
         std::string v;
+        axes.emplace_back();
         while (std::getline(values, v, ','))
-            settings.push_back({base.pass + "." + base.param + "=" + v, {{base.pass, base.param, v}}});
+            axes.back().push_back({base.pass + "." + base.param + "=" + v, {{base.pass, base.param, v}}});
     }
+    std::vector<Setting> settings{{"default", {}}};
+    if (!args.cartesian) {
+        for (auto& axis : axes) settings.insert(settings.end(), axis.begin(), axis.end());
+        return settings;
+    }
+    std::vector<Setting> product{{"", {}}};
+    for (auto& axis : axes) {
+        std::vector<Setting> next;
+        for (auto& p : product)
+            for (auto& value : axis) {
+                Setting s{p.label.empty() ? value.label : p.label + " " + value.label, p.overrides};
+                s.overrides.insert(s.overrides.end(), value.overrides.begin(), value.overrides.end());
+                next.push_back(std::move(s));
+            }
+        product = std::move(next);
+        if (product.size() > 4096) usageError("--cartesian: more than 4096 combinations");
+    }
+    settings.insert(settings.end(), product.begin(), product.end());
     return settings;
 }
 
@@ -331,10 +357,10 @@ int main(int argc, char** argv) {
     csv << "setting,total_gpu_ms,rmse,rel_mse,ssim,psnr,pixels,pareto,rel_mse_indirect";
     for (const char* name : kRegionNames) csv << ",rel_mse_" << name;
     csv << ",pass_ms\n";
-    std::printf("%-36s %9s %9s %9s %7s %7s %9s  %-31s %s\n", "setting", "gpu ms", "RMSE", "relMSE", "SSIM", "PSNR",
+    std::printf("%-44s %9s %9s %9s %7s %7s %9s  %-31s %s\n", "setting", "gpu ms", "RMSE", "relMSE", "SSIM", "PSNR",
                 "indirect", "relMSE floor/walls/ceil/objects", "front");
     for (auto& r : results) {
-        std::printf("%-36s %9.2f %9.5f %9.5f %7.4f %7.2f %9.5f  %7.4f %7.4f %7.4f %7.4f  %s\n", r.label.c_str(), r.totalMs,
+        std::printf("%-44s %9.2f %9.5f %9.5f %7.4f %7.2f %9.5f  %7.4f %7.4f %7.4f %7.4f  %s\n", r.label.c_str(), r.totalMs,
                     r.errors.rmse, r.errors.relMse, r.errors.ssim, r.errors.psnr, r.indirectRelMse, r.regionRelMse[0],
                     r.regionRelMse[1], r.regionRelMse[2], r.regionRelMse[3], r.pareto ? "*" : "");
         std::string passes;

@@ -2,8 +2,8 @@
 // small size, with a burst of live edits in the middle (a shader edit, a pipeline
 // parameter edit and a scene reload, each applied and reverted through the real file
 // watcher on temporary copies of the files), watching for leaks and bad values:
-//   RSS (every 10 frames; growth = mean of the last quarter of the run after warm-up
-//   minus mean of the first quarter), bytes of the textures the host owns, open file
+//   RSS (every 10 frames; growth before the edit burst, across it and after it, each
+//   the difference of the means of two neighbouring stretches), bytes of the textures the host owns, open file
 //   descriptors and threads at the end of warm-up (10 %, ≥ 100 frames) and at the end; GL errors (the debug callback's count); NaN/Inf in a
 //   read-back of every texture every --scan-every frames.
 // Prints a table, writes JSON (--out DIR, soak.json) and exits 1 if anything grew beyond
@@ -208,6 +208,7 @@ int main(int argc, char** argv) {
         const auto t0 = Clock::now();
         int frame = 0;
         bool burstDone = false;
+        int burstEnd = frames;
         // RSS every 10 frames: it moves by ±10 MiB from frame to frame (the driver's
         // allocations), so growth compares the mean of the first quarter after warm-up
         // with the mean of the last quarter, not two single readings.
@@ -249,6 +250,7 @@ int main(int argc, char** argv) {
                     });
                     (applied && reverted ? editsApplied : editsMissed) += 6;
                 }
+                burstEnd = frame;
             }
         }
         const double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
@@ -256,19 +258,27 @@ int main(int argc, char** argv) {
         nanCount += nonFinite(rt, nanWhere);
         atEnd = sample(frame);
         const uint64_t glErrors = gl::debugErrorCount() - errorsAtStart;
-        const int quarter = (frame - warmup) / 4;
-        double early = 0, late = 0;
-        int nEarly = 0, nLate = 0;
-        for (auto& [f, rss] : rssTrace) {
-            if (f <= warmup + quarter) early += double(rss), ++nEarly;
-            if (f >= frame - quarter) late += double(rss), ++nLate;
-        }
-        early = nEarly ? early / nEarly : double(atWarmup.rss);
-        late = nLate ? late / nLate : double(atEnd.rss);
-        const double rssGrowthMb = (late - early) / (1 << 20);
+        // A leak grows with frames: before the burst and after it, the second half of the
+        // stretch against its first half. What the edits cost once (new programs, the
+        // driver's caches for them) is the step across the burst.
+        auto meanMib = [&](int from, int to) {
+            double sum = 0;
+            int n = 0;
+            for (auto& [f, rss] : rssTrace)
+                if (f >= from && f < to) sum += double(rss), ++n;
+            return n ? sum / n / (1 << 20) : 0.0;
+        };
+        const int preMid = (warmup + burstAt) / 2, postMid = (burstEnd + frame) / 2;
+        const double early = meanMib(warmup, preMid) * (1 << 20), late = meanMib(postMid, frame + 1) * (1 << 20);
+        const double growthBefore = meanMib(preMid, burstAt) - meanMib(warmup, preMid);
+        const double stepAcross = meanMib(burstEnd, postMid) - meanMib(preMid, burstAt);
+        const double growthAfter = meanMib(postMid, frame + 1) - meanMib(burstEnd, postMid);
+        const double rssGrowthMb = std::max({growthBefore, stepAcross, growthAfter});
 
         std::vector<std::string> problems;
-        if (rssGrowthMb > rssToleranceMb) problems.push_back("RSS grew " + std::to_string(rssGrowthMb) + " MiB after warm-up");
+        if (growthBefore > rssToleranceMb) problems.push_back("RSS grew " + std::to_string(growthBefore) + " MiB before the edits");
+        if (stepAcross > rssToleranceMb) problems.push_back("RSS rose " + std::to_string(stepAcross) + " MiB across the edits");
+        if (growthAfter > rssToleranceMb) problems.push_back("RSS grew " + std::to_string(growthAfter) + " MiB after the edits");
         if (atEnd.glBytes != atWarmup.glBytes) problems.push_back("texture bytes changed after warm-up");
         if (atEnd.textures != atWarmup.textures) problems.push_back("texture count changed after warm-up");
         if (atEnd.fds > atWarmup.fds) problems.push_back("open file descriptors grew");
@@ -283,8 +293,11 @@ int main(int argc, char** argv) {
         std::printf("  %-22s %14s %14s %12s\n", "", "warm-up", "end", "tolerance");
         std::printf("  %-22s %14llu %14llu %12s\n", "frame", (unsigned long long)atWarmup.frame, (unsigned long long)atEnd.frame, "");
         std::printf("  %-22s %14.1f %14.1f %12s\n", "RSS (MiB)", atWarmup.rss / 1048576.0, atEnd.rss / 1048576.0, "");
-        std::printf("  %-22s %14.1f %14.1f %12s\n", "RSS mean, 1st/4th qtr", early / 1048576.0, late / 1048576.0,
-                    ("+" + std::to_string(int(rssToleranceMb))).c_str());
+        std::printf("  %-22s %14.1f %14.1f %12s\n", "RSS mean, first/last", early / 1048576.0, late / 1048576.0, "");
+        const std::string tol = "+" + std::to_string(int(rssToleranceMb));
+        std::printf("  %-22s %14s %14.1f %12s\n", "RSS growth before edits", "", growthBefore, tol.c_str());
+        std::printf("  %-22s %14s %14.1f %12s\n", "RSS step across edits", "", stepAcross, tol.c_str());
+        std::printf("  %-22s %14s %14.1f %12s\n", "RSS growth after edits", "", growthAfter, tol.c_str());
         std::printf("  %-22s %14llu %14llu %12s\n", "texture bytes", (unsigned long long)atWarmup.glBytes,
                     (unsigned long long)atEnd.glBytes, "equal");
         std::printf("  %-22s %14zu %14zu %12s\n", "textures", atWarmup.textures, atEnd.textures, "equal");
@@ -305,8 +318,10 @@ int main(int argc, char** argv) {
         };
         json << "{\n  \"frames\": " << frame << ",\n  \"width\": " << width << ",\n  \"height\": " << height
              << ",\n  \"seconds\": " << seconds << ",\n  \"warmup\": " << s(atWarmup) << ",\n  \"end\": " << s(atEnd)
-             << ",\n  \"rss_mean_first_quarter_bytes\": " << uint64_t(early)
-             << ",\n  \"rss_mean_last_quarter_bytes\": " << uint64_t(late) << ",\n  \"rss_growth_mib\": " << rssGrowthMb << ",\n  \"rss_tolerance_mib\": " << rssToleranceMb
+             << ",\n  \"rss_mean_first_bytes\": " << uint64_t(early)
+             << ",\n  \"rss_mean_last_bytes\": " << uint64_t(late) << ",\n  \"rss_growth_before_edits_mib\": " << growthBefore
+             << ",\n  \"rss_step_across_edits_mib\": " << stepAcross << ",\n  \"rss_growth_after_edits_mib\": " << growthAfter
+             << ",\n  \"rss_growth_mib\": " << rssGrowthMb << ",\n  \"rss_tolerance_mib\": " << rssToleranceMb
              << ",\n  \"gl_errors\": " << glErrors << ",\n  \"nan_inf\": " << nanCount << ",\n  \"scans\": " << scans
              << ",\n  \"live_edits_applied\": " << editsApplied << ",\n  \"live_edits_missed\": " << editsMissed
              << ",\n  \"ok\": " << (status == 0 ? "true" : "false") << "\n}\n";
