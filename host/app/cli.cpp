@@ -44,6 +44,8 @@ Window keys and mouse:
   Space  pause/resume   .  single step   R  reset the scene
   M  spawn a marble     F  spawn a fireball
   F1  toggle the debug view              Esc  quit
+  texture window: wheel zooms about the cursor, drag pans, hover reads the value
+  compare view: drag the line across the image
 )";
 
 namespace {

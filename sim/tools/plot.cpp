@@ -54,6 +54,38 @@ std::string decadeLabel(int e) {
     return buf;
 }
 
+// An axis over [log10 lo, log10 hi] of the data: whole decades when the data spans three
+// or more, else the 1-2-5 values around it (so a sweep from 80 to 160 ms is not a sliver
+// of a 10..1000 axis). Returns the ends (log10) and the ticks (log10, label).
+struct LogAxis {
+    double lo, hi;
+    std::vector<std::pair<double, std::string>> ticks;
+};
+LogAxis logAxis(double l0, double l1) {
+    LogAxis a;
+    if (l1 - l0 >= 3.0) {
+        const int e0 = int(std::floor(l0)), e1 = std::max(e0 + 1, int(std::ceil(l1)));
+        a.lo = e0, a.hi = e1;
+        const int step = std::max(1, (e1 - e0 + 7) / 8);
+        for (int e = e0; e <= e1; e += step) a.ticks.emplace_back(e, decadeLabel(e));
+        return a;
+    }
+    std::vector<double> nice;  // 1, 2, 5 × 10^k around the data
+    for (int e = int(std::floor(l0)) - 1; e <= int(std::ceil(l1)) + 1; ++e)
+        for (double m : {1.0, 2.0, 5.0}) nice.push_back(std::log10(m) + e);
+    a.lo = l0, a.hi = l1;
+    for (double v : nice) if (v <= l0 + 1e-9) a.lo = v;
+    for (auto it = nice.rbegin(); it != nice.rend(); ++it) if (*it >= l1 - 1e-9) a.hi = *it;
+    if (a.hi <= a.lo) a.hi = a.lo + std::log10(2.0);
+    for (double v : nice)
+        if (v >= a.lo - 1e-9 && v <= a.hi + 1e-9) {
+            char buf[24];
+            std::snprintf(buf, sizeof buf, "%g", std::pow(10.0, v));
+            a.ticks.emplace_back(v, buf);
+        }
+    return a;
+}
+
 }  // namespace
 
 bool writeLogLogPng(const std::string& path, const LogLogPlot& plot, std::string& error, int width, int height) {
@@ -65,23 +97,19 @@ bool writeLogLogPng(const std::string& path, const LogLogPlot& plot, std::string
                 ly0 = std::min(ly0, std::log10(y)), ly1 = std::max(ly1, std::log10(y));
             }
     if (lx0 > lx1) lx0 = 0, lx1 = 1, ly0 = 0, ly1 = 1;
-    const int ex0 = int(std::floor(lx0)), ex1 = std::max(ex0 + 1, int(std::ceil(lx1)));
-    const int ey0 = int(std::floor(ly0)), ey1 = std::max(ey0 + 1, int(std::ceil(ly1)));
+    const LogAxis ax = logAxis(lx0, lx1), ay = logAxis(ly0, ly1);
     Canvas c(width, height);
     const int left = 90, right = width - 30, top = 60, bottom = height - 70;
-    auto px = [&](double lx) { return left + (lx - ex0) / (ex1 - ex0) * (right - left); };
-    auto py = [&](double ly) { return bottom - (ly - ey0) / (ey1 - ey0) * (bottom - top); };
+    auto px = [&](double lx) { return left + (lx - ax.lo) / (ax.hi - ax.lo) * (right - left); };
+    auto py = [&](double ly) { return bottom - (ly - ay.lo) / (ay.hi - ay.lo) * (bottom - top); };
     const std::array<uint8_t, 3> grid{225, 225, 225}, axis{60, 60, 60};
-    for (int e = ex0; e <= ex1; ++e) {
-        c.line(px(e), top, px(e), bottom, grid);
-        const std::string l = decadeLabel(e);
-        c.text(int(px(e)) - c.textWidth(l) / 2, bottom + 8, l);
+    for (auto& [v, l] : ax.ticks) {
+        c.line(px(v), top, px(v), bottom, grid);
+        c.text(int(px(v)) - c.textWidth(l) / 2, bottom + 8, l);
     }
-    const int ystep = std::max(1, (ey1 - ey0 + 7) / 8);
-    for (int e = ey0; e <= ey1; e += ystep) {
-        c.line(left, py(e), right, py(e), grid);
-        const std::string l = decadeLabel(e);
-        c.text(left - 8 - c.textWidth(l), int(py(e)) - 6, l);
+    for (auto& [v, l] : ay.ticks) {
+        c.line(left, py(v), right, py(v), grid);
+        c.text(left - 8 - c.textWidth(l), int(py(v)) - 6, l);
     }
     c.line(left, bottom, right, bottom, axis, 2);
     c.line(left, top, left, bottom, axis, 2);
