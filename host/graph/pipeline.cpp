@@ -3,6 +3,7 @@
 #include "graph/pipeline.hpp"
 
 #include "graph/plan.hpp"  // formatParamValue
+#include "kiln/json_text.hpp"
 #include "kiln/names.hpp"
 
 #include <nlohmann/json.hpp>
@@ -37,20 +38,6 @@ int PipelineDesc::find(const std::string& id) const {
     for (size_t i = 0; i < passes.size(); ++i)
         if (passes[i].id == id) return static_cast<int>(i);
     return -1;
-}
-
-void lineColumn(const std::string& text, size_t offset, int& line, int& column) {
-    line = 1;
-    column = 1;
-    const size_t end = std::min(offset, text.size());
-    for (size_t i = 0; i < end; ++i) {
-        if (text[i] == '\n') {
-            ++line;
-            column = 1;
-        } else {
-            ++column;
-        }
-    }
 }
 
 namespace {
@@ -312,31 +299,16 @@ std::string syntaxMessage(const std::string& what) {
 // everything that walks the parsed value, and the size of every message about it.
 constexpr int kMaxNesting = 32;
 
-// An error at the first bracket that opens level kMaxNesting + 1 (strings skipped), or
-// nothing when the text stays within the bound.
+// An error at the first bracket that opens level kMaxNesting + 1, or nothing when the
+// text stays within the bound.
 std::optional<Diagnostic> tooDeep(const std::string& text, const std::string& fileName) {
-    int depth = 0;
-    bool inString = false;
-    for (size_t i = 0; i < text.size(); ++i) {
-        const char c = text[i];
-        if (inString) {
-            if (c == '\\') ++i;
-            else if (c == '"') inString = false;
-        } else if (c == '"') {
-            inString = true;
-        } else if (c == '[' || c == '{') {
-            if (++depth > kMaxNesting) {
-                Diagnostic d;
-                d.file = fileName;
-                lineColumn(text, i, d.line, d.column);
-                d.message = "nested deeper than " + std::to_string(kMaxNesting) + " levels";
-                return d;
-            }
-        } else if (c == ']' || c == '}') {
-            --depth;
-        }
-    }
-    return std::nullopt;
+    const size_t at = json_text::firstTooDeep(text, kMaxNesting);
+    if (at == std::string::npos) return std::nullopt;
+    Diagnostic d;
+    d.file = fileName;
+    lineColumn(text, at, d.line, d.column);
+    d.message = "nested deeper than " + std::to_string(kMaxNesting) + " levels";
+    return d;
 }
 
 // The JSON library's other refusals (a number beyond double range, 406; invalid

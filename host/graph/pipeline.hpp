@@ -26,6 +26,7 @@
 
 #include "graph/diagnostic.hpp"
 #include "kiln/declare.hpp"
+#include "kiln/json_text.hpp"
 
 #include <cstdint>
 #include <optional>
@@ -113,7 +114,8 @@ std::string writePipeline(const PipelineDesc&);
 std::optional<std::string> patchPipelineText(const std::string& original, const PipelineDesc& edited,
                                              std::string& error);
 
-// Byte offset (0-based) → 1-based line and column (column counts bytes).
-void lineColumn(const std::string& text, size_t offset, int& line, int& column);
+// Byte offset (0-based) → 1-based line and column (column counts bytes); shared with the
+// scene loader.
+using json_text::lineColumn;
 
 }  // namespace kiln::graph

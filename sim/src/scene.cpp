@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "kiln/json_text.hpp"
 #include "kiln/sim/shape.hpp"
 
 namespace kiln::sim {
@@ -186,35 +187,7 @@ bool restitution(const Json& physics, Scene::Physics::Restitution& e, SceneError
            r.finish();
 }
 
-void lineColumn(const std::string& text, size_t offset, int& line, int& column) {
-    line = 1, column = 1;
-    offset = std::min(offset, text.size());
-    for (size_t i = 0; i < offset; ++i) {
-        if (text[i] == '\n') ++line, column = 1;
-        else ++column;
-    }
-}
-
-// The first bracket that opens level kMaxSceneNesting + 1 (strings skipped), or npos.
-// Checked before parsing: nothing ever holds (copies, dumps, destroys) a deeper value.
-size_t tooDeep(const std::string& text) {
-    int depth = 0;
-    bool inString = false;
-    for (size_t i = 0; i < text.size(); ++i) {
-        const char c = text[i];
-        if (inString) {
-            if (c == '\\') ++i;
-            else if (c == '"') inString = false;
-        } else if (c == '"') {
-            inString = true;
-        } else if (c == '[' || c == '{') {
-            if (++depth > kMaxSceneNesting) return i;
-        } else if (c == ']' || c == '}') {
-            --depth;
-        }
-    }
-    return std::string::npos;
-}
+using json_text::lineColumn;
 
 // Follows the parse to know the JSON path of the value being read when the library
 // refuses one (a number beyond double range): "physics.dt", "marbles[3].position[1]".
@@ -259,7 +232,7 @@ private:
 // here: none escapes to the caller.
 bool parseJson(const std::string& text, Json& root, SceneError& error) {
     int line = 1, column = 1;
-    if (const size_t at = tooDeep(text); at != std::string::npos) {
+    if (const size_t at = json_text::firstTooDeep(text, kMaxSceneNesting); at != std::string::npos) {
         lineColumn(text, at, line, column);
         error = {"", "line " + std::to_string(line) + ", column " + std::to_string(column) + ": nested deeper than " +
                          std::to_string(kMaxSceneNesting) + " levels"};
