@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "app/app.hpp"
+#include "kiln/image_io.hpp"
 
 namespace kiln::app {
 
@@ -14,13 +15,6 @@ const run::NamedTexture* findNamed(const std::vector<run::NamedTexture>& all, co
     for (auto& t : all)
         if (t.pass + "." + t.name == name) return &t;
     return nullptr;
-}
-
-FloatImage readLevel0(const TextureRef& t) {
-    FloatImage img;
-    img.width = t.width, img.height = t.height, img.channels = 4;
-    img.pixels = readTexelBox(t, 0, {0, 0, 0}, {t.width, t.height, 1});
-    return img;
 }
 
 }  // namespace
@@ -39,7 +33,8 @@ void CompareView::measure(const App& app) {
         problem_ = "the two textures differ in size or kind";
         return;
     }
-    const FloatImage ia = readLevel0(ta->ref), ib = readLevel0(tb->ref);
+    const FloatImage ia = readTexture(ta->ref.id, ta->ref.target, ta->ref.format, ta->ref.width, ta->ref.height);
+    const FloatImage ib = readTexture(tb->ref.id, tb->ref.target, tb->ref.format, tb->ref.width, tb->ref.height);
     samples_ = int(ib.pixels.size() >= 4 ? ib.pixels[3] : 0.0f);
     errors_ = metrics::compare(ia, ib);
     problem_.clear();

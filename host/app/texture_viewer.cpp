@@ -6,15 +6,15 @@
 #include <cfloat>
 #include <cmath>
 
+#include "kiln/image_io.hpp"
 #include "kiln/log.hpp"
 
 namespace kiln::app {
 
 namespace {
 
-bool isDepthFormat(GLenum f) { return f == GL_DEPTH_COMPONENT32F || f == GL_DEPTH_COMPONENT24; }
-bool isUintFormat(GLenum f) { return f == GL_R32UI; }
-bool isSingleChannel(GLenum f) { return isDepthFormat(f) || isUintFormat(f) || f == GL_R16F || f == GL_R32F || f == GL_R8; }
+using gl::isDepthFormat;
+bool isSingleChannel(GLenum f) { return isDepthFormat(f) || gl::isIntegerFormat(f) || f == GL_R16F || f == GL_R32F || f == GL_R8; }
 
 glm::ivec3 levelSize(const TextureRef& t, int mip) {
     return {std::max(1, t.width >> mip), std::max(1, t.height >> mip),
@@ -51,28 +51,7 @@ bool depthPlanesApply(const TextureRef& t, float n, float f, const ViewSettings&
 }  // namespace
 
 std::vector<float> readTexelBox(const TextureRef& t, int level, glm::ivec3 o, glm::ivec3 n) {
-    const size_t count = size_t(n.x) * size_t(n.y) * size_t(n.z);
-    std::vector<float> rgba(count * 4, 0.0f);
-    glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    if (isDepthFormat(t.format) || isUintFormat(t.format)) {
-        std::vector<float> one(count);
-        std::vector<GLuint> ui(isUintFormat(t.format) ? count : 0);
-        if (isUintFormat(t.format))
-            glGetTextureSubImage(t.id, level, o.x, o.y, o.z, n.x, n.y, n.z, GL_RED_INTEGER, GL_UNSIGNED_INT,
-                                 GLsizei(count * sizeof(GLuint)), ui.data());
-        else
-            glGetTextureSubImage(t.id, level, o.x, o.y, o.z, n.x, n.y, n.z, GL_DEPTH_COMPONENT, GL_FLOAT,
-                                 GLsizei(count * sizeof(float)), one.data());
-        for (size_t i = 0; i < count; ++i) {
-            const float v = ui.empty() ? one[i] : float(ui[i]);
-            rgba[i * 4 + 0] = rgba[i * 4 + 1] = rgba[i * 4 + 2] = v;
-            rgba[i * 4 + 3] = 1.0f;
-        }
-    } else {
-        glGetTextureSubImage(t.id, level, o.x, o.y, o.z, n.x, n.y, n.z, GL_RGBA, GL_FLOAT, GLsizei(count * 4 * sizeof(float)),
-                             rgba.data());
-    }
-    return rgba;
+    return readTextureBox(t.id, t.format, level, o.x, o.y, o.z, n.x, n.y, n.z);
 }
 
 glm::ivec2 planeSize(const TextureRef& t, int mip, int axis) {
@@ -104,7 +83,7 @@ bool TextureViewer::init(const ShaderLibrary& shaders, std::string& error) {
 
 void TextureViewer::draw(const TextureRef& t, float depthNear, float depthFar, const ViewSettings& s, glm::ivec4 rect) const {
     if (!program_ || !t.id) return;
-    const bool is3D = t.target == GL_TEXTURE_3D, isUint = isUintFormat(t.format);
+    const bool is3D = t.target == GL_TEXTURE_3D, isUint = gl::isIntegerFormat(t.format);
     const int mip = clampedMip(t, s);
     const glm::ivec2 plane = planeSize(t, mip, s.axis);
     const glm::vec2 canvas(rect.z, rect.w);
@@ -275,7 +254,7 @@ void TextureViewer::window(const run::NamedTexture& nt, bool* open) {
             r.mip = mip;
             const std::vector<float> v = readTexelBox(t, mip, r.texel, {1, 1, 1});
             r.value = {v[0], v[1], v[2], v[3]};
-            r.isInteger = isUintFormat(t.format);
+            r.isInteger = gl::isIntegerFormat(t.format);
             r.isDepth = isDepthFormat(t.format);
             readout_ = r;
         }

@@ -50,8 +50,7 @@ struct RangeFit {
     size_t texels = 0, nonFinite = 0;
 };
 
-// Reads a box of texels of mip `level` as RGBA floats (x fastest, then y, then z):
-// R32UI as its integer value, depth in r (g = b = r, a = 1).
+// readTextureBox (kiln/image_io.hpp) of a TextureRef.
 std::vector<float> readTexelBox(const TextureRef&, int level, glm::ivec3 origin, glm::ivec3 size);
 
 // The displayed plane (a 2D level, or one slice of a 3D one along `axis`) in texels.

@@ -86,8 +86,8 @@ Texture Texture::create(GLenum target, GLenum internalFormat, int w, int h, int 
     else
         glTextureStorage2D(id, t.levels_, internalFormat, w, h);
 
-    const bool isInteger = internalFormat == GL_R32UI;
-    const bool isDepth = internalFormat == GL_DEPTH_COMPONENT32F || internalFormat == GL_DEPTH_COMPONENT24;
+    const bool isInteger = isIntegerFormat(internalFormat);
+    const bool isDepth = isDepthFormat(internalFormat);
     const GLint minFilter = isInteger ? GL_NEAREST : (t.levels_ > 1 ? GL_LINEAR_MIPMAP_LINEAR : GL_LINEAR);
     glTextureParameteri(id, GL_TEXTURE_MIN_FILTER, minFilter);
     glTextureParameteri(id, GL_TEXTURE_MAG_FILTER, isInteger ? GL_NEAREST : GL_LINEAR);

@@ -13,41 +13,40 @@
 
 namespace kiln {
 
+std::vector<float> readTextureBox(GLuint texture, GLenum internalFormat, int level, int x, int y, int z, int w, int h,
+                                  int d) {
+    const size_t count = size_t(w) * size_t(h) * size_t(d);
+    std::vector<float> rgba(count * 4, 0.0f);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    if (gl::isDepthFormat(internalFormat) || gl::isIntegerFormat(internalFormat)) {
+        std::vector<float> one(count);
+        std::vector<GLuint> ui(gl::isIntegerFormat(internalFormat) ? count : 0);
+        if (!ui.empty())
+            glGetTextureSubImage(texture, level, x, y, z, w, h, d, GL_RED_INTEGER, GL_UNSIGNED_INT,
+                                 GLsizei(count * sizeof(GLuint)), ui.data());
+        else
+            glGetTextureSubImage(texture, level, x, y, z, w, h, d, GL_DEPTH_COMPONENT, GL_FLOAT,
+                                 GLsizei(count * sizeof(float)), one.data());
+        for (size_t i = 0; i < count; ++i) {
+            const float v = ui.empty() ? one[i] : float(ui[i]);
+            rgba[i * 4 + 0] = rgba[i * 4 + 1] = rgba[i * 4 + 2] = v;
+            rgba[i * 4 + 3] = 1.0f;
+        }
+    } else {
+        glGetTextureSubImage(texture, level, x, y, z, w, h, d, GL_RGBA, GL_FLOAT, GLsizei(count * 4 * sizeof(float)),
+                             rgba.data());
+    }
+    return rgba;
+}
+
 FloatImage readTexture(GLuint texture, GLenum target, GLenum internalFormat, int width, int height, int level,
                        int layer) {
     FloatImage img;
     img.width = std::max(1, width >> level);
     img.height = std::max(1, height >> level);
     img.channels = 4;
-    const size_t count = static_cast<size_t>(img.width) * img.height * 4;
-    img.pixels.assign(count, 0.0f);
-    const bool isDepth = internalFormat == GL_DEPTH_COMPONENT32F || internalFormat == GL_DEPTH_COMPONENT24;
-    const bool isUint = internalFormat == GL_R32UI;
-    glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    if (isDepth || isUint) {
-        std::vector<float> one(static_cast<size_t>(img.width) * img.height);
-        std::vector<GLuint> ui(isUint ? one.size() : 0);
-        const int z = target == GL_TEXTURE_3D ? std::max(layer, 0) : 0;
-        if (isDepth)
-            glGetTextureSubImage(texture, level, 0, 0, z, img.width, img.height, 1, GL_DEPTH_COMPONENT, GL_FLOAT,
-                                 static_cast<GLsizei>(one.size() * sizeof(float)), one.data());
-        else
-            glGetTextureSubImage(texture, level, 0, 0, z, img.width, img.height, 1, GL_RED_INTEGER, GL_UNSIGNED_INT,
-                                 static_cast<GLsizei>(ui.size() * sizeof(GLuint)), ui.data());
-        for (size_t i = 0; i < one.size(); ++i) {
-            float v = isUint ? static_cast<float>(ui[i]) : one[i];
-            img.pixels[i * 4 + 0] = img.pixels[i * 4 + 1] = img.pixels[i * 4 + 2] = v;
-            img.pixels[i * 4 + 3] = 1.0f;
-        }
-        return img;
-    }
-    if (target == GL_TEXTURE_3D) {
-        glGetTextureSubImage(texture, level, 0, 0, std::max(layer, 0), img.width, img.height, 1, GL_RGBA, GL_FLOAT,
-                             static_cast<GLsizei>(count * sizeof(float)), img.pixels.data());
-    } else {
-        glGetTextureImage(texture, level, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(count * sizeof(float)),
-                          img.pixels.data());
-    }
+    const int z = target == GL_TEXTURE_3D ? std::max(layer, 0) : 0;
+    img.pixels = readTextureBox(texture, internalFormat, level, 0, 0, z, img.width, img.height, 1);
     return img;
 }
 

@@ -90,10 +90,10 @@ namespace {
 void clearToDefault(const gl::Texture& t) {
     for (int level = 0; level < t.levels(); ++level) {
         const GLenum f = t.internalFormat();
-        if (f == GL_DEPTH_COMPONENT32F || f == GL_DEPTH_COMPONENT24) {
+        if (gl::isDepthFormat(f)) {
             const float one = 1.0f;
             glClearTexImage(t.id(), level, GL_DEPTH_COMPONENT, GL_FLOAT, &one);
-        } else if (f == GL_R32UI) {
+        } else if (gl::isIntegerFormat(f)) {
             glClearTexImage(t.id(), level, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
         } else {
             glClearTexImage(t.id(), level, GL_RGBA, GL_FLOAT, nullptr);

@@ -144,5 +144,8 @@ private:
 
 // Maps GL enums to readable names for error messages ("GL_RGBA16F").
 const char* formatName(GLenum internalFormat);
+// The formats that are read, cleared and sampled differently from colour floats.
+inline bool isDepthFormat(GLenum f) { return f == GL_DEPTH_COMPONENT32F || f == GL_DEPTH_COMPONENT24; }
+inline bool isIntegerFormat(GLenum f) { return f == GL_R32UI; }
 
 }  // namespace kiln::gl

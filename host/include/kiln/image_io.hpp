@@ -11,6 +11,10 @@
 
 namespace kiln {
 
+// Reads a box of texels of mip `level` as RGBA floats, x fastest, then y, then z:
+// R32UI as its integer value, depth in r (g = b = r, a = 1).
+std::vector<float> readTextureBox(GLuint texture, GLenum internalFormat, int level, int x, int y, int z, int w, int h,
+                                  int d);
 // Reads mip `level` of a 2D texture (or slice `layer` of a 3D one) as RGBA float.
 FloatImage readTexture(GLuint texture, GLenum target, GLenum internalFormat, int width, int height, int level = 0,
                        int layer = -1);
