@@ -9,20 +9,8 @@
 
 namespace kiln::app {
 
-namespace {
-
-const run::NamedTexture* findNamed(const std::vector<run::NamedTexture>& all, const std::string& name) {
-    for (auto& t : all)
-        if (t.pass + "." + t.name == name) return &t;
-    return nullptr;
-}
-
-}  // namespace
-
 void CompareView::measure(const App& app) {
-    const auto all = app.runtime().textures();
-    const run::NamedTexture* ta = findNamed(all, a);
-    const run::NamedTexture* tb = findNamed(all, b);
+    const auto ta = app.runtime().namedTexture(a), tb = app.runtime().namedTexture(b);
     errors_.reset();
     if (!ta || !tb) {
         problem_ = std::string("no texture ") + (!ta ? a : b) + " in the running pipeline (pipelines/compare.json has both)";
@@ -79,11 +67,10 @@ void CompareView::panel(App& app, double now, glm::vec2 at, const std::function<
 }
 
 void CompareView::draw(const TextureViewer& viewer, const App& app, glm::ivec4 rect) const {
-    const auto all = app.runtime().textures();
     ViewSettings s;
     s.tonemap = tonemap;
-    if (const run::NamedTexture* ta = findNamed(all, a)) viewer.draw(ta->ref, 0, 0, s, rect);
-    if (const run::NamedTexture* tb = findNamed(all, b)) {
+    if (const auto ta = app.runtime().namedTexture(a)) viewer.draw(ta->ref, 0, 0, s, rect);
+    if (const auto tb = app.runtime().namedTexture(b)) {
         const int x = rect.x + int(std::lround(split * float(rect.z)));
         glEnable(GL_SCISSOR_TEST);
         glScissor(x, rect.y, rect.x + rect.z - x, rect.w);

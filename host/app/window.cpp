@@ -455,15 +455,12 @@ void drawSidebar(WindowState& state) {
         fg->AddText(ImVec2(x + 8, float(state.image.y) + 4), IM_COL32_WHITE, "B");
         if (state.probe.on()) state.probe.widgets["compare-line"] = {x - 2, state.image.y, x + 2, state.image.y + state.image.w};
     }
-    if (state.showTexture && !app.viewed.empty()) {
-        for (auto& t : app.runtime().textures())
-            if (t.pass + "." + t.name == app.viewed) {
-                state.viewer.window(t, &state.showTexture);
-                const glm::vec4 c = state.viewer.canvasRect();
-                if (state.probe.on()) state.probe.widgets["texture-canvas"] = {c.x, c.y, c.z, c.w};
-                break;
-            }
-    }
+    if (state.showTexture)
+        if (const auto t = app.runtime().namedTexture(app.viewed)) {
+            state.viewer.window(*t, &state.showTexture);
+            const glm::vec4 c = state.viewer.canvasRect();
+            if (state.probe.on()) state.probe.widgets["texture-canvas"] = {c.x, c.y, c.z, c.w};
+        }
 }
 
 GLuint imageTextureFor(const App& app, const WindowState& state, run::NamedTexture& named) {
@@ -472,8 +469,7 @@ GLuint imageTextureFor(const App& app, const WindowState& state, run::NamedTextu
     named = {};
     named.ref = *t;
     if (state.mainShowsSelection)
-        for (auto& n : app.runtime().textures())
-            if (n.pass + "." + n.name == app.viewed) named = n;
+        if (const auto n = app.runtime().namedTexture(app.viewed)) named = *n;
     return t->id;
 }
 

@@ -367,6 +367,19 @@ const TextureRef* Runtime::findTexture(std::string_view pass, std::string_view n
     return nullptr;
 }
 
+std::optional<NamedTexture> Runtime::namedTexture(std::string_view qualified) const {
+    const size_t dot = qualified.find('.');
+    if (dot == std::string_view::npos) return std::nullopt;
+    for (auto& s : slots_) {
+        if (s->id != qualified.substr(0, dot)) continue;
+        auto it = s->textures.find(qualified.substr(dot + 1));
+        if (it == s->textures.end()) return std::nullopt;
+        const PooledTexture& t = it->second;
+        return NamedTexture{s->id, it->first, t.internal, t.ref, t.decl.depthNear, t.decl.depthFar};
+    }
+    return std::nullopt;
+}
+
 std::vector<PassRow> Runtime::stats() const {
     std::vector<PassRow> rows;
     for (auto& s : slots_) rows.push_back(s->timings.row(s->id, s->module));

@@ -85,6 +85,8 @@ public:
     std::vector<PassRow> stats() const;
     std::string statsTable() const { return formatStatsTable(stats()); }
     std::vector<NamedTexture> textures() const;
+    // One of textures() by its "pass.name", without listing them all.
+    std::optional<NamedTexture> namedTexture(std::string_view qualified) const;
     bool dump(const std::filesystem::path& dir, std::string& error) const { return dumpTextures(textures(), dir, error); }
 
     // Live reload. Rebuilds every program that read one of `changedFiles` (absolute
