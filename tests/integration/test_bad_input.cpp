@@ -72,7 +72,8 @@ void check(const Case& c) {
 
 TEST_CASE("bad command-line values", "[integration][cli][robust]") {
     for (const char* args : {"--size 0x0", "--size -5x5", "--size 100000x100000", "--size 12", "--size", "--frames -3",
-                             "--frames", "--frames 1x", "--bogus", "--pipeline", "--seed banana"}) {
+                             "--frames", "--frames 1x", "--bogus", "--pipeline", "--seed banana",
+                             "--budget -1", "--budget fast", "--budget", "--ui-probe"}) {
         const Run r = runKiln(std::string("--headless ") + args, 60);
         INFO(args << "\n" << r.err);
         CHECK(r.exitCode == 1);

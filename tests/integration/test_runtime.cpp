@@ -1,6 +1,7 @@
 // The runtime's resource pool and skipping, on the real modules.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -191,4 +192,56 @@ TEST_CASE("textures beyond the budget or the GL limits are a named error and the
     CHECK_THAT(errors, Catch::Contains("beyond this GL's GL_MAX_TEXTURE_SIZE " + std::to_string(max2D)));
     CHECK(rt.resize(80, 80, errors));
     CHECK(rt.findTexture("gbuffer", "albedo")->width == 80);
+}
+
+TEST_CASE("setParam changes the running pass without a recompile, refuses bad values by name, resizes by recompiling", "[runtime][gl]") {
+    Fixture f;
+    run::Runtime& rt = f.app.runtime();
+    std::string errors;
+    REQUIRE(rt.loadPipelineText(pipelineWithExposure(1.0), "a.json", errors));
+    f.app.frame();
+    auto centreLuma = [&] {
+        const TextureRef* t = rt.findTexture("composite", "color");
+        const FloatImage img = readTexture(t->id, t->target, t->format, t->width, t->height);
+        const float* p = img.at(img.width / 2, img.height / 2);
+        return p[0] + p[1] + p[2];
+    };
+    auto ran = [&](const std::string& id) {
+        for (auto& r : rt.stats())
+            if (r.id == id) return r.ranFrames;
+        return -1;
+    };
+    const float before = centreLuma();
+    const int gbufferRuns = ran("gbuffer"), compositeRuns = ran("composite");
+    const std::string fileText = rt.pipelineText();
+
+    std::string error;
+    REQUIRE(rt.setParam("composite", "exposure", 0.25f, error));
+    CHECK(*rt.plan()->passes[size_t(rt.plan()->find("composite"))].params.get<float>("exposure") == 0.25f);
+    f.app.frame();
+    CHECK(ran("composite") == compositeRuns + 1);  // it runs again ...
+    CHECK(ran("gbuffer") == gbufferRuns);          // ... and nothing upstream does
+    CHECK(centreLuma() < before * 0.75f);          // a quarter of the exposure, through ACES
+    CHECK(rt.pipelineText() == fileText);          // the file's text is only changed by write-back
+    // The description carries the edit (what write-back writes and a recompile keeps).
+    const graph::PassDesc& desc = rt.pipelineDesc()->passes[size_t(rt.pipelineDesc()->find("composite"))];
+    CHECK(std::any_of(desc.params.begin(), desc.params.end(),
+                      [](auto& p) { return p.first == "exposure" && p.second.f == 0.25; }));
+
+    CHECK_FALSE(rt.setParam("composite", "exposure", 99.0f, error));
+    CHECK_THAT(error, Catch::Contains("composite.params.exposure") && Catch::Contains("out of range"));
+    CHECK_FALSE(rt.setParam("composite", "exposure", std::string("bright"), error));
+    CHECK_THAT(error, Catch::Contains("expected float"));
+    CHECK_FALSE(rt.setParam("composite", "nope", 1.0f, error));
+    CHECK_THAT(error, Catch::Contains("no parameter \"nope\""));
+    CHECK_FALSE(rt.setParam("ghost", "exposure", 1.0f, error));
+    CHECK_THAT(error, Catch::Contains("no pass \"ghost\""));
+    CHECK(*rt.plan()->passes[size_t(rt.plan()->find("composite"))].params.get<float>("exposure") == 0.25f);  // kept
+
+    // A parameter a texture is sized from goes through a recompile: the texture follows.
+    REQUIRE(f.app.runtime().loadPipeline(KILN_SOURCE_DIR "/pipelines/default.json", errors));
+    REQUIRE(rt.setParam("shadow", "size", 512, error));
+    const TextureRef* depth = rt.findTexture("shadow", "depth");
+    REQUIRE(depth);
+    CHECK(depth->width == 512);
 }
