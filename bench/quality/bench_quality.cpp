@@ -54,7 +54,7 @@ namespace {
 // resolution) and the shadow filter and map size.
 const char* const kDefaultSweeps[] = {
     "voxelize.resolution=32,64,128", "voxel_mip.mode=iso,aniso",     "cone_trace.cones=1,5,6,9,16",
-    "cone_trace.aperture=30,45,60,90", "cone_trace.schedule=octave,continuous", "cone_trace.half_res=true,false",
+    "cone_trace.aperture=30,45,60,90", "cone_trace.schedule=octave,continuous", "cone_trace.trace_stride=1,2,4",
     "composite.pcf=1,3,5,9",          "shadow.size=512,1024,2048,4096",
 };
 

@@ -15,9 +15,12 @@
 //
 // Anisotropic chains: bind voxel_mip.aniso to `aniso` (KILN_HAS_ANISO), and the iso
 // chain (always) to `voxels`: level 0 of every lookup comes from it.
-// half_res: trace every second pixel in x and y into the internal `half`, then a
-// depth/normal-aware upsample writes `indirect` (about 4× cheaper; its error against
-// full resolution is measured in tests/gi).
+// trace_stride 2 or 4: trace one pixel in every 2×2 (4×4) block into the internal
+// `half` (`quarter`), with the traced surface's plane beside it, then a
+// depth/normal-aware upsample writes `indirect`. Indirect light is smooth on surfaces,
+// so the error stays small where a traced sample lies on the pixel's own surface
+// (measured against full resolution in tests/gi and against the path-traced
+// reference by kiln-bench-quality); silhouettes reach further for a matching sample.
 #include <kiln/pass.hpp>
 
 #include <algorithm>
@@ -118,7 +121,13 @@ public:
                     .doc = "voxel_mip.aniso: sample the directional chains"})
             .output({.name = "indirect", .format = Format::RGBA16F, .doc = "rgb = indirect irradiance / π, a = AO"})
             .internal({.name = "half", .format = Format::RGBA16F, .size = SizeRule::relative(0.5f),
-                       .doc = "the half-resolution trace (half_res)"})
+                       .doc = "trace_stride 2: the traced samples"})
+            .internal({.name = "half_plane", .format = Format::RGBA16F, .size = SizeRule::relative(0.5f),
+                       .doc = "trace_stride 2: each sample's surface, xyz = normal, w = n·p (0,0,0 off geometry)"})
+            .internal({.name = "quarter", .format = Format::RGBA16F, .size = SizeRule::relative(0.25f),
+                       .doc = "trace_stride 4: the traced samples"})
+            .internal({.name = "quarter_plane", .format = Format::RGBA16F, .size = SizeRule::relative(0.25f),
+                       .doc = "trace_stride 4: each sample's surface"})
             .param(intChoiceParam("cones", 6, {1, 5, 6, 9, 16}, "diffuse cones per pixel"))
             .param(floatParam("aperture", 60.0f, 5.0, 150.0, "cone opening angle, degrees"))
             .param(floatParam("max_distance", 2.0f, 0.1, 3.5, "cone length, world units (box side = 2)"))
@@ -128,7 +137,8 @@ public:
             .param(floatParam("start_offset", 1.0f, 0.0, 4.0, "cone origin pushed along the normal, in voxels"))
             .param(floatParam("diameter_offset", 0.5f, 0.0, 2.0,
                               "each sample pushed off the surface by this × its diameter (against self-occlusion)"))
-            .param(boolParam("half_res", false, "trace at half resolution and upsample (depth/normal aware)"))
+            .param(intChoiceParam("trace_stride", 1, {1, 2, 4},
+                                  "trace one pixel per N×N block and upsample (depth/normal aware); 1 = every pixel"))
             .param(floatParam("upsample_tolerance", 0.02f, 0.001, 1.0, "plane distance (world) that halves a sample's weight"));
         d.reads = kSceneCamera;
         return d;
@@ -140,14 +150,16 @@ public:
                                     .defines = schedule(ctx, voxels.width)});
         GLuint upsample = ctx.program({.stages = {"common/fullscreen.vert", "cone_trace/upsample.frag"}});
         if (!trace || !upsample) return;
-        const bool half = ctx.getBool("half_res");
+        const int stride = ctx.getInt("trace_stride");
+        const char* samples = stride == 4 ? "quarter" : "half";
+        const char* planes = stride == 4 ? "quarter_plane" : "half_plane";
 
         glBindTextureUnit(0, ctx.input("normal").id);
         glBindTextureUnit(1, ctx.input("depth").id);
         glBindTextureUnit(2, voxels.id);
         glBindTextureUnit(3, ctx.input("aniso").id);
 
-        if (!ctx.framebuffer({half ? "half" : "indirect"})) return;
+        if (!(stride > 1 ? ctx.framebuffer({samples, planes}) : ctx.framebuffer({"indirect"}))) return;
         glUseProgram(trace);
         const std::vector<float> cones = coneSet(ctx.getInt("cones"));
         auto loc = [&](const char* n) { return glGetUniformLocation(trace, n); };
@@ -157,13 +169,15 @@ public:
         glUniform1f(loc("u_startOffset"), ctx.getFloat("start_offset"));
         glUniform1f(loc("u_diameterOffset"), ctx.getFloat("diameter_offset"));
         glUniform1f(loc("u_voxelRes"), float(voxels.width));
-        glUniform1i(loc("u_stride"), half ? 2 : 1);
+        glUniform1i(loc("u_stride"), stride);
         ctx.drawFullscreenTriangle();
 
-        if (half) {
+        if (stride > 1) {
             if (!ctx.framebuffer({"indirect"})) return;
             glUseProgram(upsample);
-            glBindTextureUnit(4, ctx.internal("half").id);
+            glBindTextureUnit(4, ctx.internal(samples).id);
+            glBindTextureUnit(5, ctx.internal(planes).id);
+            glUniform1i(glGetUniformLocation(upsample, "u_stride"), stride);
             glUniform1f(glGetUniformLocation(upsample, "u_planeTolerance"), ctx.getFloat("upsample_tolerance"));
             ctx.drawFullscreenTriangle();
         }

@@ -1,26 +1,28 @@
 #version 450 core
-// Per-pixel diffuse cone tracing (full resolution, or every second pixel in x and y
-// when half_res: then pixel ij traces the G-buffer texel 2·ij and upsample.frag fills
-// the full-resolution output).
+// Per-pixel diffuse cone tracing: every pixel (stride 1), or one pixel per stride×stride
+// block: then pixel ij traces the G-buffer texel stride·ij + stride/2 (traceTexel in
+// upsample.glsl) and also writes that surface's plane for upsample.frag.
 #include "common/frame.glsl"
 #include "trace.glsl"
+#include "upsample.glsl"
 
 layout(binding = 0) uniform sampler2D u_normal;
 layout(binding = 1) uniform sampler2D u_depth;
-uniform int u_stride;  // 1 full resolution, 2 half
+uniform int u_stride;
 
 layout(location = 0) out vec4 o_indirect;
+layout(location = 1) out vec4 o_plane;  // xyz = unit normal, w = n·p; 0 off geometry
 
 void main() {
-    ivec2 src = ivec2(gl_FragCoord.xy) * u_stride;
+    ivec2 src = traceTexel(ivec2(gl_FragCoord.xy), u_stride);
     vec4 n4 = texelFetch(u_normal, src, 0);
     if (n4.w < 0.5) {
         o_indirect = vec4(0.0, 0.0, 0.0, 1.0);
+        o_plane = vec4(0.0);
         return;
     }
-    float depth = texelFetch(u_depth, src, 0).r;
-    vec2 ndc = (vec2(src) + 0.5) * u_outputSize.zw * 2.0 - 1.0;
-    vec4 w = u_invViewProj * vec4(ndc, depth * 2.0 - 1.0, 1.0);
-    vec3 p = w.xyz / w.w;
-    o_indirect = traceDiffuse(p, normalize(n4.xyz));
+    vec3 p = worldAtTexel(u_depth, src);
+    vec3 n = normalize(n4.xyz);
+    o_indirect = traceDiffuse(p, n);
+    o_plane = vec4(n, dot(n, p));
 }

@@ -1,24 +1,30 @@
 #version 450 core
-// Depth- and normal-aware upsample of the half-resolution trace: each output pixel
-// blends the 2×2 nearest half-resolution samples with bilinear weights × how well each
-// sample's surface matches its own (normal agreement, distance from its tangent
-// plane). Half pixel ij traced the G-buffer texel 2·ij (cone_trace.frag), so the
-// comparison uses the G-buffer at exactly those texels. No sample matches: the
-// nearest one.
+// Depth- and normal-aware upsample of a strided trace: each output pixel blends the
+// 2×2 nearest samples with bilinear weights × how well each sample's surface matches
+// its own: normal agreement (cos⁸) and the pixel's distance from the sample's tangent
+// plane (the plane comes with the sample, so a tap is two fetches and no matrix).
+// None of the four matches (thin parts, small particles): the nearest sample.
+// No wider search for those few pixels: llvmpipe runs both sides of a divergent
+// branch under lane masks, so a fallback that almost never runs still costs every
+// pixel its taps (a 3×3 search measured +9 ms at 720², for a handful of pixels).
 #include "common/frame.glsl"
+#include "upsample.glsl"
 
 layout(binding = 0) uniform sampler2D u_normal;
 layout(binding = 1) uniform sampler2D u_depth;
-layout(binding = 4) uniform sampler2D u_half;
+layout(binding = 4) uniform sampler2D u_samples;
+layout(binding = 5) uniform sampler2D u_planes;
+uniform int u_stride;
 uniform float u_planeTolerance;  // world units
 
 layout(location = 0) out vec4 o_indirect;
 
-vec3 worldAt(ivec2 px) {
-    float depth = texelFetch(u_depth, px, 0).r;
-    vec2 ndc = (vec2(px) + 0.5) * u_outputSize.zw * 2.0 - 1.0;
-    vec4 w = u_invViewProj * vec4(ndc, depth * 2.0 - 1.0, 1.0);
-    return w.xyz / w.w;
+float surfaceMatch(vec3 n, vec3 p, ivec2 h) {
+    vec4 plane = texelFetch(u_planes, h, 0);
+    float c = max(dot(n, plane.xyz), 0.0);  // 0 where the sample saw no geometry
+    c *= c;
+    c *= c;
+    return c * c * exp(-abs(dot(plane.xyz, p) - plane.w) / u_planeTolerance);
 }
 
 void main() {
@@ -29,24 +35,21 @@ void main() {
         return;
     }
     vec3 n = normalize(n4.xyz);
-    vec3 p = worldAt(px);
-    ivec2 halfSize = textureSize(u_half, 0);
-    ivec2 h0 = px >> 1;
-    vec2 f = vec2(px & 1) * 0.5;
+    vec3 p = worldAtTexel(u_depth, px);
+    ivec2 last = textureSize(u_samples, 0) - 1;
+    // Sample h sits at pixel stride·h + stride/2: px in sample units.
+    vec2 u = (vec2(px) - float(u_stride / 2)) / float(u_stride);
+    ivec2 h0 = ivec2(floor(u));
+    vec2 f = u - vec2(h0);
     vec4 sum = vec4(0.0);
     float wsum = 0.0;
     for (int k = 0; k < 4; ++k) {
         ivec2 o = ivec2(k & 1, k >> 1);
-        ivec2 h = min(h0 + o, halfSize - 1);
-        ivec2 src = min(h * 2, ivec2(u_outputSize.xy) - 1);
-        vec4 sn = texelFetch(u_normal, src, 0);
+        ivec2 h = clamp(h0 + o, ivec2(0), last);
         float bil = (o.x == 1 ? f.x : 1.0 - f.x) * (o.y == 1 ? f.y : 1.0 - f.y);
-        float wn = sn.w > 0.5 ? pow(max(dot(n, normalize(sn.xyz)), 0.0), 8.0) : 0.0;
-        float plane = abs(dot(n, worldAt(src) - p));
-        float wp = exp(-plane / u_planeTolerance);
-        float weight = bil * wn * wp;
-        sum += weight * texelFetch(u_half, h, 0);
-        wsum += weight;
+        float w = (bil + 1e-3) * surfaceMatch(n, p, h);
+        sum += w * texelFetch(u_samples, h, 0);
+        wsum += w;
     }
-    o_indirect = wsum > 1e-4 ? sum / wsum : texelFetch(u_half, min(h0, halfSize - 1), 0);
+    o_indirect = wsum > 1e-5 ? sum / wsum : texelFetch(u_samples, clamp(ivec2(round(u)), ivec2(0), last), 0);
 }
