@@ -12,12 +12,14 @@ public:
     kiln::PassDeclaration declare() const override {
         using namespace kiln;
         PassDeclaration d;
-        d.input({.name = "albedo"})
-            .input({.name = "normal"})
-            .input({.name = "depth", .kind = TextureKind::Depth2D})
-            .input({.name = "emissive", .required = false, .fallback = Fallback::Black})
+        // The G-buffer inputs and `indirect` are read texel for texel (the output's size);
+        // the bloom and the shadow map are filtered lookups at any size.
+        d.input({.name = "albedo", .doc = "output-sized"})
+            .input({.name = "normal", .doc = "output-sized"})
+            .input({.name = "depth", .kind = TextureKind::Depth2D, .doc = "output-sized"})
+            .input({.name = "emissive", .required = false, .fallback = Fallback::Black, .doc = "output-sized"})
             .input({.name = "shadow_map", .kind = TextureKind::Depth2D, .required = false})
-            .input({.name = "indirect", .required = false, .fallback = Fallback::Black})
+            .input({.name = "indirect", .required = false, .fallback = Fallback::Black, .doc = "output-sized"})
             .input({.name = "bloom", .required = false, .fallback = Fallback::Black})
             .output({.name = "color", .format = Format::RGBA8, .doc = "tonemapped, gamma-encoded final image"})
             .output({.name = "hdr", .format = Format::RGBA16F, .doc = "linear radiance before bloom, exposure and tonemapping"})
@@ -25,7 +27,8 @@ public:
             .param(floatParam("ambient", 0.03f, 0.0, 1.0, "constant fill light when no indirect input is bound"))
             .param(enumParam("tonemap", "aces", {"aces", "reinhard", "clamp"}))
             .param(floatParam("gamma", 2.2f, 1.0, 3.0))
-            .param(intChoiceParam("pcf", 5, {1, 3, 5, 7, 9}, "shadow filter kernel side: 5 = the seed's 5x5, 1 = hard"))
+            .param(intChoiceParam("pcf", 5, {1, 3, 5, 7, 9},
+                                  "shadow filter about k+1 texels wide from ((k+1)/2)² bilinear depth comparisons; 1 = one"))
             .param(floatParam("indirect_strength", 1.0f, 0.0, 8.0, "scales the bound indirect irradiance (1 = physical)"))
             .param(floatParam("shadow_bias", 0.0005f, 0.0, 0.05, "depth bias of the shadow test"))
             .param(intChoiceParam("lamp_samples", 32, {4, 8, 16, 32, 64},
@@ -36,22 +39,43 @@ public:
 
     void execute(kiln::PassContext& ctx) override {
         GLuint program = ctx.program({.stages = {"common/fullscreen.vert", "composite/composite.frag"},
-                                      .defines = {{"KILN_LAMP_SAMPLES", std::to_string(ctx.getInt("lamp_samples"))}}});
+                                      .defines = {{"KILN_LAMP_SAMPLES", std::to_string(ctx.getInt("lamp_samples"))},
+                                                  {"KILN_PCF", std::to_string(ctx.getInt("pcf"))}}});
         if (!program) return;
         if (!ctx.framebuffer({"color", "hdr"})) return;
         glUseProgram(program);
         const char* inputs[] = {"albedo", "normal", "depth", "emissive", "shadow_map", "indirect", "bloom"};
         for (GLuint unit = 0; unit < 7; ++unit) glBindTextureUnit(unit, ctx.input(inputs[unit]).id);
+        // The shadow map is read through hardware comparison (sampler2DShadow): each
+        // lookup a bilinear blend of four depth tests. A sampler object, so the shadow
+        // pass's texture keeps its own state for the passes that read raw depth.
+        if (!compareSampler_) {
+            glCreateSamplers(1, &compareSampler_);
+            glSamplerParameteri(compareSampler_, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+            glSamplerParameteri(compareSampler_, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+            glSamplerParameteri(compareSampler_, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+            glSamplerParameteri(compareSampler_, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+            glSamplerParameteri(compareSampler_, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+            glSamplerParameteri(compareSampler_, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+        }
+        glBindSampler(4, compareSampler_);
         const std::string& tonemap = ctx.getEnum("tonemap");
         glUniform1f(glGetUniformLocation(program, "u_exposure"), ctx.getFloat("exposure"));
         glUniform1f(glGetUniformLocation(program, "u_ambient"), ctx.getFloat("ambient"));
         glUniform1f(glGetUniformLocation(program, "u_gamma"), ctx.getFloat("gamma"));
         glUniform1i(glGetUniformLocation(program, "u_tonemap"), tonemap == "aces" ? 0 : tonemap == "reinhard" ? 1 : 2);
-        glUniform1i(glGetUniformLocation(program, "u_pcf"), ctx.getInt("pcf"));
         glUniform1f(glGetUniformLocation(program, "u_shadowBias"), ctx.getFloat("shadow_bias"));
         glUniform1f(glGetUniformLocation(program, "u_indirectStrength"), ctx.getFloat("indirect_strength"));
         ctx.drawFullscreenTriangle();
+        glBindSampler(4, 0);
     }
+
+    ~Composite() override {
+        if (compareSampler_) glDeleteSamplers(1, &compareSampler_);
+    }
+
+private:
+    GLuint compareSampler_ = 0;
 };
 
 }  // namespace

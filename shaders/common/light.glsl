@@ -69,26 +69,32 @@ vec3 lampLight(vec3 p, vec3 n) {
     return u_lightColor.rgb * (sum * area / float(KILN_LAMP_SAMPLES));
 }
 
-// Fraction of the lamp that sees p through a shadow map of the casters: a k×k
-// percentage-closer filter (k = 1: one hard test). Outside the light's frustum: lit.
-// The four corner taps go first: when they agree (far from any shadow edge, most of
-// the picture) the answer is theirs and the other k²−4 taps are skipped.
-float shadowVisibility(sampler2D shadowMap, vec3 p, int k, float bias) {
+// One hard shadow-map test: 1 where p is nearer the lamp than the caster depth
+// stored for its texel. Outside the light's frustum: lit.
+float shadowHard(sampler2D shadowMap, vec3 p, float bias) {
     vec4 ls = lightSpace(p);
-    if (ls.w == 0.0) return 1.0;
+    return ls.w == 0.0 || ls.z - bias <= texture(shadowMap, ls.xy).r ? 1.0 : 0.0;
+}
+
+// Fraction of the lamp that sees p: a percentage-closer filter through a comparison
+// sampler (GL_LINEAR + GL_COMPARE_REF_TO_TEXTURE, GL_LEQUAL), so each lookup is
+// already a bilinear blend of four depth tests. KILN_PCF = k: (k+1)/2 × (k+1)/2
+// lookups two texels apart, a smooth filter about k+1 texels wide (5 → 9 lookups over
+// 6×6 texels, where a nearest-texel 5×5 box needs 25). Unrolled: the kernel is a
+// compile-time constant (on llvmpipe a loop with a uniform bound, and a branch around
+// taps, cost more than the taps). Outside the light's frustum: lit.
+#ifndef KILN_PCF
+#define KILN_PCF 5
+#endif
+float shadowFiltered(sampler2DShadow shadowMap, vec3 p, float bias) {
+    vec4 ls = lightSpace(p);
+    const int n = (KILN_PCF + 1) / 2;
     vec2 texel = 1.0 / vec2(textureSize(shadowMap, 0));
-    int r = k / 2;
-    float z = ls.z - bias;
-    if (r > 0) {
-        float c = (z <= texture(shadowMap, ls.xy + vec2(-r, -r) * texel).r ? 1.0 : 0.0)
-                + (z <= texture(shadowMap, ls.xy + vec2(r, -r) * texel).r ? 1.0 : 0.0)
-                + (z <= texture(shadowMap, ls.xy + vec2(-r, r) * texel).r ? 1.0 : 0.0)
-                + (z <= texture(shadowMap, ls.xy + vec2(r, r) * texel).r ? 1.0 : 0.0);
-        if (c == 0.0 || c == 4.0) return c * 0.25;
-    }
     float lit = 0.0;
-    for (int y = -r; y <= r; ++y)
-        for (int x = -r; x <= r; ++x)
-            lit += (z <= texture(shadowMap, ls.xy + vec2(x, y) * texel).r) ? 1.0 : 0.0;
-    return lit / float((2 * r + 1) * (2 * r + 1));
+    for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) {
+            vec2 offset = (vec2(x, y) * 2.0 - float(n - 1)) * texel;
+            lit += texture(shadowMap, vec3(ls.xy + offset, ls.z - bias));
+        }
+    return ls.w == 0.0 ? 1.0 : lit / float(n * n);
 }

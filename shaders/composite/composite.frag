@@ -15,7 +15,7 @@ layout(binding = 0) uniform sampler2D u_albedo;
 layout(binding = 1) uniform sampler2D u_normal;
 layout(binding = 2) uniform sampler2D u_depth;
 layout(binding = 3) uniform sampler2D u_emissive;
-layout(binding = 4) uniform sampler2D u_shadowMap;
+layout(binding = 4) uniform sampler2DShadow u_shadowMap;  // a comparison sampler is bound with it
 layout(binding = 5) uniform sampler2D u_indirect;
 layout(binding = 6) uniform sampler2D u_bloom;
 
@@ -23,15 +23,14 @@ uniform float u_exposure;
 uniform float u_ambient;
 uniform float u_gamma;
 uniform int u_tonemap;   // kTonemapAces, kTonemapReinhard, kTonemapClamp
-uniform int u_pcf;
 uniform float u_shadowBias;
 uniform float u_indirectStrength;
 
 // Fraction of the lamp that sees p: a k×k percentage-closer filter over the shadow
-// map (k = u_pcf; 1 is a hard shadow). No map bound: everything is lit.
+// map (k = KILN_PCF; 1 is one bilinear test). No map bound: everything is lit.
 float lightVisibility(vec3 p) {
 #if KILN_HAS_SHADOW_MAP
-    return shadowVisibility(u_shadowMap, p, u_pcf, u_shadowBias);
+    return shadowFiltered(u_shadowMap, p, u_shadowBias);
 #else
     return 1.0;
 #endif
@@ -43,17 +42,20 @@ vec3 worldPosition(vec2 uv, float depth) {
 }
 
 void main() {
-    vec4 n4 = texture(u_normal, v_uv);
-    vec3 emissive = texture(u_emissive, v_uv).rgb;
+    // Every input but the bloom is the output's size: texel fetches, no filtering.
+    ivec2 px = ivec2(gl_FragCoord.xy);
+    vec4 n4 = texelFetch(u_normal, px, 0);
+    // The optional ones may be the 1×1 fallback: clamped.
+    vec3 emissive = texelFetch(u_emissive, min(px, textureSize(u_emissive, 0) - 1), 0).rgb;
     vec3 radiance = vec3(0.0);
     if (n4.w > 0.5) {
-        vec3 albedo = texture(u_albedo, v_uv).rgb;
-        vec3 p = worldPosition(v_uv, texture(u_depth, v_uv).r);
+        vec3 albedo = texelFetch(u_albedo, px, 0).rgb;
+        vec3 p = worldPosition(v_uv, texelFetch(u_depth, px, 0).r);
         vec3 n = normalize(n4.xyz);
         vec3 irradiance = lampLight(p, n);
         float visible = max(irradiance.r, max(irradiance.g, irradiance.b)) > 0.0 ? lightVisibility(p + n * 0.004) : 0.0;
         vec3 direct = albedo / 3.14159265 * irradiance * visible;
-        vec3 indirect = albedo * u_indirectStrength * texture(u_indirect, v_uv).rgb;
+        vec3 indirect = albedo * u_indirectStrength * texelFetch(u_indirect, min(px, textureSize(u_indirect, 0) - 1), 0).rgb;
 #if KILN_HAS_INDIRECT == 0
         indirect = albedo * u_ambient;
 #endif

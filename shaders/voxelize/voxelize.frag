@@ -38,7 +38,7 @@ void main() {
     vec3 n = normalize(v_normal);
     float vis = 1.0;
 #if KILN_HAS_SHADOW_MAP
-    vis = shadowVisibility(u_shadowMap, v_world + n * (2.0 / float(u_res)), 1, u_shadowBias);
+    vis = shadowHard(u_shadowMap, v_world + n * (2.0 / float(u_res)), u_shadowBias);
 #endif
     vec3 radiance = albedo / 3.14159265 * lampLight(v_world, n) * vis + inst.emissive.rgb * u_emissionScale;
     uvec3 fixedRgb = uvec3(clamp(radiance, 0.0, kMaxRadiance) * kFixedScale + 0.5);
