@@ -1,0 +1,34 @@
+#version 450 core
+// Bright-pass and 2× downsample in one: each invocation averages one 2×2 block of the
+// full-resolution input, each texel first reduced to its part above the threshold
+// (colour scaled by (lum − threshold) / lum), and stores the half-resolution texel.
+// The group also reduces the brightest input luminance into one atomicMax, which the
+// blur reads to write black without a tap when nothing passes. Non-negative floats
+// order like their bit patterns, so the maximum is kept as uint bits.
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(binding = 0) uniform sampler2D u_color;
+layout(binding = 0, rgba16f) uniform writeonly image2D u_bright;
+layout(std430, binding = 1) buffer MaxLum { uint u_maxBits; };
+uniform float u_threshold;
+shared float s_max[64];
+
+void main() {
+    ivec2 size = textureSize(u_color, 0);
+    ivec2 q = ivec2(gl_GlobalInvocationID.xy);
+    vec3 sum = vec3(0.0);
+    float m = 0.0;
+    for (int k = 0; k < 4; ++k) {
+        vec3 c = texelFetch(u_color, min(2 * q + ivec2(k & 1, k >> 1), size - 1), 0).rgb;
+        float l = dot(c, vec3(0.2126, 0.7152, 0.0722));
+        m = max(m, l);  // NaN never wins
+        sum += l > u_threshold ? c * ((l - u_threshold) / l) : vec3(0.0);
+    }
+    if (all(lessThan(q, imageSize(u_bright)))) imageStore(u_bright, q, vec4(0.25 * sum, 1.0));
+    s_max[gl_LocalInvocationIndex] = m;
+    barrier();
+    for (uint s = 32u; s > 0u; s >>= 1) {
+        if (gl_LocalInvocationIndex < s) s_max[gl_LocalInvocationIndex] = max(s_max[gl_LocalInvocationIndex], s_max[gl_LocalInvocationIndex + s]);
+        barrier();
+    }
+    if (gl_LocalInvocationIndex == 0u) atomicMax(u_maxBits, floatBitsToUint(min(s_max[0], 65504.0)));
+}
