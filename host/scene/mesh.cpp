@@ -70,6 +70,21 @@ MeshData makeUvSphere(int slices, int stacks) {
     return m;
 }
 
+MeshData makeParticle() {
+    MeshData m;
+    const glm::vec3 axes[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    for (const glm::vec3& a : axes) m.vertices.push_back({a * 1.35f, a});
+    // One face per octant, wound counter-clockwise seen from outside.
+    for (uint32_t x : {0u, 1u})
+        for (uint32_t y : {2u, 3u})
+            for (uint32_t z : {4u, 5u}) {
+                const bool flip = ((x == 1) != (y == 3)) != (z == 5);  // an odd number of negative axes
+                if (flip) m.indices.insert(m.indices.end(), {x, z, y});
+                else m.indices.insert(m.indices.end(), {x, y, z});
+            }
+    return m;
+}
+
 MeshData makeTumbler(float b, float t, float alpha, int slices, int stacks) {
     // Profile rings from the bottom pole to the top pole: lower cap from −90° up to
     // latitude α (where the cone touches), the cone band, then the upper cap from α

@@ -1,6 +1,6 @@
 // scene/mesh.hpp — the scene's meshes, generated on the CPU on each scene load: a unit
 // wall quad, the icosphere lamp dome, the tumbler (round cone) and spheres, each in two levels of
-// detail. Indexed triangles; position + normal per vertex.
+// detail, and the particles' octahedron. Indexed triangles; position + normal per vertex.
 #pragma once
 
 #include <cstdint>
@@ -27,6 +27,12 @@ MeshData makeQuad();
 // point outward (into the room).
 MeshData makeLampDome(glm::vec3 centre, float radius, int level, float clipY);
 MeshData makeUvSphere(int slices, int stacks);  // unit radius
+// The particles' mesh: an octahedron with its vertices at 1.35, which gives it the
+// unit sphere's mean projected area (surface/4: 6.93·1.35²/4 ≈ π), so a particle
+// covers as much screen and as many voxels as a sphere would, from 8 triangles
+// instead of a sphere's 120 (9 000 particles are 72 000 triangles, not 1.1 million).
+// Normals are radial: interpolated, they shade like a sphere.
+MeshData makeParticle();
 // A round cone: lower sphere radius b at the origin, upper sphere radius t at
 // (0, (b − t)/sin α, 0), joined by the tangent cone. `slices` around, `stacks` per cap.
 MeshData makeTumbler(float b, float t, float alpha, int slices, int stacks);

@@ -17,6 +17,7 @@ void SceneRenderer::buildMeshes(const SceneLook& look) {
         makeTumbler(look.tumblerB, look.tumblerT, look.tumblerAlpha, 12, 4),
         makeUvSphere(32, 16),
         makeUvSphere(10, 6),
+        makeParticle(),
     };
     std::vector<Vertex> vertices;
     std::vector<uint32_t> indices;
@@ -122,7 +123,7 @@ void SceneRenderer::rebuildGroups() {
     add(kTumblerHigh, kTumblerLow, kSceneTumblers);
     add(kSphereHigh, kSphereLow, kSceneMarbles);
     add(kSphereHigh, kSphereLow, kSceneFireballs);
-    add(kSphereLow, kSphereLow, kSceneParticles);
+    add(kParticle, kParticle, kSceneParticles);
 }
 
 void SceneRenderer::upload() {

@@ -9,7 +9,7 @@ void main() {
     KilnInstance inst = kilnInstance();
     vec4 world = inst.model * vec4(a_position, 1.0);
     v_world = world.xyz;
-    v_normal = transpose(inverse(mat3(inst.model))) * a_normal;
+    v_normal = kilnWorldNormal(inst, a_normal);
     v_instance = a_instance;
     gl_Position = u_viewProj * world;
 }

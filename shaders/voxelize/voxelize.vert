@@ -10,7 +10,7 @@ void main() {
     KilnInstance inst = kilnInstance();
     vec4 world = inst.model * vec4(a_position, 1.0);
     vg_world = world.xyz;
-    vg_normal = transpose(inverse(mat3(inst.model))) * a_normal;
+    vg_normal = kilnWorldNormal(inst, a_normal);
     vg_instance = a_instance;
     gl_Position = world;
 }
