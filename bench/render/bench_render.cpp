@@ -1,13 +1,26 @@
 // kiln-bench-render — per-pass GPU and CPU time of pipelines and parameter sweeps,
 // headless. A command, not a test: it prints a table and writes CSV.
 //
-//   kiln-bench-render [--pipeline FILE]... [--size WxH] [--frames N] [--repeats R]
-//                     [--set PASS.PARAM=JSON]... [--sweep PASS.PARAM=V1,V2,...] [--out DIR]
+//   kiln-bench-render [--pipeline FILE]... [--scene FILE] [--size WxH] [--frames N]
+//                     [--repeats R] [--settle SECONDS] [--set PASS.PARAM=JSON]...
+//                     [--sweep PASS.PARAM=V1,V2,...] [--grow fireballs|marbles=N1,N2,...]
+//                     [--out DIR]
 //
 // Every pass runs every frame (skipping off) so each frame measures the full cost; the
-// first 3 frames (shader compilation, first-touch allocation) are discarded. GPU times
-// come from GL timestamp pairs; "frame ms" is wall time per frame with a glFinish,
-// which on llvmpipe is what a user waits for.
+// scene moves (the simulation steps every frame). The first 3 frames (shader
+// compilation, first-touch allocation) are discarded. GPU times come from GL timestamp
+// pairs; "frame ms" is wall time per frame with a glFinish, which on llvmpipe is what
+// a user waits for. Configurations are measured in rounds: each round visits every
+// configuration once (a slow minute of a shared machine lands on all of them alike);
+// the figures are medians over frames, then over rounds.
+//
+// Each configuration first simulates --settle seconds (default 1.5, without
+// rendering) so the fire's particles reach their steady count: the first frames of a
+// run have almost none.
+// --grow: the scene with its fireball (marble) list replaced by N of them on a lattice
+// in the upper box, per N.
+// Prints frame cost against the body and particle counts and writes growth.csv and
+// growth.png besides render.csv.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -19,6 +32,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/app.hpp"
+#include "plot.hpp"
 #include "app/context.hpp"
 #include "kiln/log.hpp"
 #include "support/bench_support.hpp"
@@ -34,12 +48,16 @@ struct Config {
     std::string pipeline;
     std::vector<Override> overrides;
     std::string label;
+    std::string scene;  // empty: the default scene
+    int grown = -1;     // --grow: the body count
 };
 
 struct Args {
     std::vector<std::string> pipelines;
     std::vector<Override> sets;
-    std::string sweep;
+    std::string sweep, scene, growKind;
+    std::vector<int> growCounts;
+    double settle = 1.5;
     int width = 720, height = 720, frames = 20, repeats = 3;
     std::string outDir = "bench-out";
 };
@@ -66,14 +84,35 @@ Args parseArgs(int argc, char** argv) {
         else if (a == "--repeats") args.repeats = std::max(1, std::atoi(next().c_str()));
         else if (a == "--out") args.outDir = next();
         else if (a == "--sweep") args.sweep = next();
+        else if (a == "--scene") args.scene = next();
+        else if (a == "--settle") {
+            args.settle = std::atof(next().c_str());
+            if (!(args.settle >= 0 && args.settle <= 60)) usageError("--settle: expected seconds in [0, 60]");
+        } else if (a == "--grow") {
+            const std::string v = next();
+            const size_t eq = v.find('=');
+            args.growKind = v.substr(0, eq);
+            if (eq == std::string::npos || (args.growKind != "fireballs" && args.growKind != "marbles"))
+                usageError("--grow " + v + ": expected fireballs=N1,N2,... or marbles=N1,N2,...");
+            std::stringstream counts(v.substr(eq + 1));
+            std::string c;
+            while (std::getline(counts, c, ',')) {
+                char* end = nullptr;
+                const long n = std::strtol(c.c_str(), &end, 10);
+                if (c.empty() || *end || n < 0 || n > 1000) usageError("--grow " + v + ": counts are integers in [0, 1000]");
+                args.growCounts.push_back(int(n));
+            }
+        }
         else if (a == "--set") {
             Override o;
             std::string error;
             if (!parseOverride(next(), o, error)) usageError("--set " + error);
             args.sets.push_back(o);
         } else if (a == "--help" || a == "-h") {
-            std::printf("usage: kiln-bench-render [--pipeline FILE]... [--size WxH] [--frames N] [--repeats R]\n"
-                        "                         [--set PASS.PARAM=JSON]... [--sweep PASS.PARAM=V1,V2,...] [--out DIR]\n");
+            std::printf("usage: kiln-bench-render [--pipeline FILE]... [--scene FILE] [--size WxH] [--frames N]\n"
+                        "                         [--repeats R] [--settle SECONDS] [--set PASS.PARAM=JSON]...\n"
+                        "                         [--sweep PASS.PARAM=V1,V2,...] [--grow fireballs|marbles=N1,N2,...]\n"
+                        "                         [--out DIR]\n");
             std::exit(0);
         } else {
             usageError("unknown argument \"" + a + "\"");
@@ -83,13 +122,46 @@ Args parseArgs(int argc, char** argv) {
     return args;
 }
 
-// One config per pipeline, or per pipeline × sweep value.
+// The scene file with its `kind` list ("fireballs" or "marbles") replaced by `count`
+// bodies like its first one (or a default), on a 5 × 4 × 5 lattice over the upper box
+// (x, z in ±0.64, y in [0.0, 0.75]), each with its own deterministic velocity.
+std::string grownScene(const std::string& sceneFile, const std::string& kind, int count, const std::string& outDir) {
+    Json scene = Json::parse(slurp(sceneFile));
+    Json like = scene.contains(kind) && !scene[kind].empty() ? scene[kind][0] : Json::object();
+    if (!like.contains("radius")) like["radius"] = 0.05;
+    if (!like.contains("color")) like["color"] = {1.0, 0.5, 0.1};
+    Json list = Json::array();
+    for (int i = 0; i < count; ++i) {
+        const int slot = i % 100, layer = i / 100;
+        const double x = -0.64 + 0.32 * (slot % 5), z = -0.64 + 0.32 * ((slot / 5) % 5);
+        const double y = 0.0 + 0.25 * (slot / 25) + 0.05 * layer;
+        Json b = like;
+        b["position"] = {x + (kind == "fireballs" ? 0.08 : 0.0), y, z};
+        const double a = 2.399963 * i;  // golden-angle headings, speeds 0.6..1.2
+        const double speed = 0.6 + 0.6 * std::fmod(0.618034 * i, 1.0);
+        b["velocity"] = {speed * std::cos(a), 0.3 * speed * std::sin(1.7 * a), speed * std::sin(a)};
+        list.push_back(b);
+    }
+    scene[kind] = list;
+    const std::string path = (fs::path(outDir) / ("scene-" + kind + "-" + std::to_string(count) + ".json")).string();
+    std::ofstream(path) << scene.dump(2) << "\n";
+    return path;
+}
+
+// One config per pipeline, per pipeline × sweep value, or per pipeline × grown scene.
 std::vector<Config> configsOf(const Args& args) {
     std::vector<Config> configs;
     for (auto& p : args.pipelines) {
         std::string name = fs::path(p).stem().string();
+        if (!args.growKind.empty()) {
+            const std::string base = args.scene.empty() ? std::string(KILN_SOURCE_DIR) + "/scenes/cornell.json" : args.scene;
+            for (int n : args.growCounts)
+                configs.push_back({p, args.sets, name + " " + std::to_string(n) + " " + args.growKind,
+                                   grownScene(base, args.growKind, n, args.outDir), n});
+            continue;
+        }
         if (args.sweep.empty()) {
-            configs.push_back({p, args.sets, name});
+            configs.push_back({p, args.sets, name, args.scene});
             continue;
         }
         Override base;
@@ -98,7 +170,7 @@ std::vector<Config> configsOf(const Args& args) {
         std::stringstream values(base.json);
         std::string v;
         while (std::getline(values, v, ',')) {
-            Config c{p, args.sets, name + " " + base.pass + "." + base.param + "=" + v};
+            Config c{p, args.sets, name + " " + base.pass + "." + base.param + "=" + v, args.scene};
             c.overrides.push_back({base.pass, base.param, v});
             configs.push_back(c);
         }
@@ -108,40 +180,44 @@ std::vector<Config> configsOf(const Args& args) {
 
 struct Measured {
     std::vector<std::string> order;                  // pass ids in plan order
-    std::map<std::string, std::vector<double>> gpu, cpu;  // per-repeat medians
-    std::vector<double> frameMs;
+    std::map<std::string, std::vector<double>> gpu, cpu;  // per-round medians
+    std::vector<double> frameMs, particles;
+    int bodies = 0;
 };
 
-// `repeats` fresh runs of `text`: 3 warm-up frames, then `frames` timed ones.
-bool measure(const Args& args, const Config& config, const std::string& text, Measured& m, std::string& error) {
-    for (int r = 0; r < args.repeats; ++r) {
-        app::Options o;
-        app::applyDefaults(o);
-        o.headless = true;
-        o.width = args.width;
-        o.height = args.height;
-        o.pipeline = config.pipeline;
-        app::App app;
-        if (!app.init(o, error) || !app.runtime().loadPipelineText(text, config.pipeline, error)) return false;
-        app.runtime().alwaysRun = true;
-        for (int f = 0; f < 3; ++f) app.frame();
+// One round of `config`: a fresh app, --settle seconds simulated, 3 warm-up frames,
+// then `frames` timed ones.
+bool measureRound(const Args& args, const Config& config, const std::string& text, Measured& m, std::string& error) {
+    app::Options o;
+    app::applyDefaults(o);
+    o.headless = true;
+    o.width = args.width;
+    o.height = args.height;
+    o.pipeline = config.pipeline;
+    if (!config.scene.empty()) o.scene = config.scene;
+    app::App app;
+    if (!app.init(o, error) || !app.runtime().loadPipelineText(text, config.pipeline, error)) return false;
+    app.runtime().alwaysRun = true;
+    while (app.scene().time() + 1e-9 < args.settle) app.scene().step();
+    for (int f = 0; f < 3; ++f) app.frame();
+    glFinish();
+    app.runtime().resetTimings();  // only the frames after warm-up count
+    std::vector<double> walls;
+    for (int f = 0; f < args.frames; ++f) {
+        auto t0 = std::chrono::steady_clock::now();
+        app.frame();
         glFinish();
-        app.runtime().resetTimings();  // only the frames after warm-up count
-        std::vector<double> walls;
-        for (int f = 0; f < args.frames; ++f) {
-            auto t0 = std::chrono::steady_clock::now();
-            app.frame();
-            glFinish();
-            walls.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-        }
-        app.runtime().collectGpuTimes();
-        m.frameMs.push_back(median(walls));
-        for (auto& row : app.runtime().stats()) {
-            if (r == 0) m.order.push_back(row.id);
-            if (row.ranFrames == 0) continue;
-            m.gpu[row.id].push_back(row.gpuMedianMs);
-            m.cpu[row.id].push_back(row.cpuMedianMs);
-        }
+        walls.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    }
+    app.runtime().collectGpuTimes();
+    m.frameMs.push_back(median(walls));
+    m.particles.push_back(double(app.scene().sim().particles().size()));
+    const bool first = m.order.empty();
+    for (auto& row : app.runtime().stats()) {
+        if (first) m.order.push_back(row.id);
+        if (row.ranFrames == 0) continue;
+        m.gpu[row.id].push_back(row.gpuMedianMs);
+        m.cpu[row.id].push_back(row.cpuMedianMs);
     }
     return true;
 }
@@ -161,6 +237,41 @@ void report(const Config& config, Measured& m, std::ofstream& csv) {
 
 }  // namespace
 
+// growth.csv and growth.png: frame cost against the grown body count, per pipeline.
+void reportGrowth(const Args& args, const std::vector<Config>& configs, std::vector<Measured>& measured) {
+    const std::string csvPath = (fs::path(args.outDir) / "growth.csv").string();
+    std::ofstream csv(csvPath);
+    csv << "pipeline," << args.growKind << ",particles,frame_ms,ratio,voxelize_ms,gbuffer_ms,shadow_ms\n";
+    std::printf("growth: frame cost against %s (ratio to the first count of the same pipeline)\n", args.growKind.c_str());
+    std::printf("  %-10s %9s %10s %9s %7s %11s %10s %9s\n", "pipeline", args.growKind.c_str(), "particles", "frame ms",
+                "ratio", "voxelize ms", "gbuffer ms", "shadow ms");
+    LogLogPlot plot{"frame cost against " + args.growKind + " (" + std::to_string(args.width) + "x" +
+                        std::to_string(args.height) + ", moving)",
+                    args.growKind, "frame ms (wall, glFinish)", {}};
+    const std::array<uint8_t, 3> colors[] = {{30, 90, 200}, {200, 60, 40}, {40, 150, 60}, {120, 60, 160}};
+    std::map<std::string, double> base;
+    for (size_t i = 0; i < configs.size(); ++i) {
+        const std::string pipeline = fs::path(configs[i].pipeline).stem().string();
+        Measured& m = measured[i];
+        const double frame = median(m.frameMs);
+        if (!base.count(pipeline)) {
+            base[pipeline] = frame;
+            plot.series.push_back({pipeline, colors[(plot.series.size()) % 4], {}, true, 3});
+        }
+        for (auto& s : plot.series)
+            if (s.label == pipeline) s.points.push_back({double(std::max(configs[i].grown, 1)), frame});
+        auto gpu = [&](const char* id) { return m.gpu.count(id) ? median(m.gpu[id]) : 0.0; };
+        std::printf("  %-10s %9d %10.0f %9.2f %7.2f %11.2f %10.2f %9.2f\n", pipeline.c_str(), configs[i].grown,
+                    median(m.particles), frame, frame / base[pipeline], gpu("voxelize"), gpu("gbuffer"), gpu("shadow"));
+        csv << pipeline << "," << configs[i].grown << "," << median(m.particles) << "," << frame << ","
+            << frame / base[pipeline] << "," << gpu("voxelize") << "," << gpu("gbuffer") << "," << gpu("shadow") << "\n";
+    }
+    std::string error;
+    const std::string png = (fs::path(args.outDir) / "growth.png").string();
+    if (writeLogLogPng(png, plot, error)) std::printf("wrote %s and %s\n", csvPath.c_str(), png.c_str());
+    else std::fprintf(stderr, "kiln-bench-render: %s: %s\n", png.c_str(), error.c_str());
+}
+
 int main(int argc, char** argv) {
     const Args args = parseArgs(argc, argv);
     const std::vector<Config> configs = configsOf(args);
@@ -171,23 +282,28 @@ int main(int argc, char** argv) {
         return 1;
     }
     log::setMinLevel(log::Level::Warn);
-    std::printf("device: %s\nsize %dx%d, %d frames x %d repeats (medians), every pass every frame\n\n",
+    std::printf("device: %s\nsize %dx%d, %d frames x %d rounds (medians), every pass every frame, the scene moving\n\n",
                 context->description().c_str(), args.width, args.height, args.frames, args.repeats);
 
     fs::create_directories(args.outDir);
     const std::string csvPath = (fs::path(args.outDir) / "render.csv").string();
     std::ofstream csv(csvPath);
     csv << "config,pass,module,gpu_ms,cpu_ms,frame_ms\n";
-    for (auto& config : configs) {
-        std::string text;
-        Measured m;
-        if (!applyOverrides(slurp(config.pipeline), config.overrides, text, error) ||
-            !measure(args, config, text, m, error)) {
-            std::fprintf(stderr, "kiln-bench-render: error: %s: %s\n", config.pipeline.c_str(), error.c_str());
+    std::vector<std::string> texts(configs.size());
+    for (size_t i = 0; i < configs.size(); ++i)
+        if (!applyOverrides(slurp(configs[i].pipeline), configs[i].overrides, texts[i], error)) {
+            std::fprintf(stderr, "kiln-bench-render: error: %s: %s\n", configs[i].pipeline.c_str(), error.c_str());
             return 1;
         }
-        report(config, m, csv);
-    }
+    std::vector<Measured> measured(configs.size());
+    for (int round = 0; round < args.repeats; ++round)
+        for (size_t i = 0; i < configs.size(); ++i)
+            if (!measureRound(args, configs[i], texts[i], measured[i], error)) {
+                std::fprintf(stderr, "kiln-bench-render: error: %s: %s\n", configs[i].pipeline.c_str(), error.c_str());
+                return 1;
+            }
+    for (size_t i = 0; i < configs.size(); ++i) report(configs[i], measured[i], csv);
+    if (!args.growKind.empty()) reportGrowth(args, configs, measured);
     std::printf("wrote %s\n", csvPath.c_str());
     return 0;
 }
