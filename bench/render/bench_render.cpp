@@ -143,6 +143,7 @@ std::string grownScene(const std::string& sceneFile, const std::string& kind, in
         list.push_back(b);
     }
     scene[kind] = list;
+    fs::create_directories(outDir);
     const std::string path = (fs::path(outDir) / ("scene-" + kind + "-" + std::to_string(count) + ".json")).string();
     std::ofstream(path) << scene.dump(2) << "\n";
     return path;
