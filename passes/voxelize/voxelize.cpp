@@ -26,6 +26,10 @@
 //      loop (the RGBA8 running-average trick serialises colliding fragments and
 //      quantises radiance to 8 bits; imageStore of RGBA16F would keep an arbitrary
 //      last fragment).
+//   Particles (thousands of tiny emitters) skip steps 1–2 by default: a compute pass
+//      (voxelize/splat.comp) adds each one, as one fragment, to the voxels its bounding
+//      box overlaps. Rasterized, each cost 8 geometry-shader triangles; 50 fireballs'
+//      4 000 particles took voxelize from 14 to 61 ms at 720² (particle_mode "mesh").
 //   4. A compute pass (4³ groups) resolves sum/count into `radiance`: rgb = the mean
 //      outgoing radiance, a = occupancy (1 where any fragment landed, else 0). The
 //      colour is premultiplied by the occupancy (empty voxels are 0,0,0,0), which is
@@ -61,6 +65,9 @@ public:
             .param(boolParam("conservative", true, "enlarge triangles by half a voxel (no holes from thin triangles)"))
             .param(boolParam("marbles", false, "voxelize the marbles too (the seed leaves them out)"))
             .param(boolParam("particles", true, "voxelize the emissive particles"))
+            .param(enumParam("particle_mode", "splat", {"splat", "mesh"},
+                             "splat: a compute pass adds each particle to the voxels it overlaps; mesh: rasterize "
+                             "its octahedron like every other mesh"))
             .param(floatParam("lamp_emission", 0.0f, 0.0, 1.0,
                               "scale of the lamp dome's own emission in the voxels (its light already arrives "
                               "through composite's direct term: 1 counts it twice)"))
@@ -72,7 +79,10 @@ public:
     void execute(kiln::PassContext& ctx) override {
         GLuint raster = ctx.program({.stages = {"voxelize/voxelize.vert", "voxelize/voxelize.geom", "voxelize/voxelize.frag"}});
         GLuint resolve = ctx.program({.stages = {"voxelize/resolve.comp"}});
-        if (!raster || !resolve) return;
+        const bool particles = ctx.getBool("particles");
+        const bool splat = particles && ctx.getEnum("particle_mode") == "splat";
+        GLuint splatter = splat ? ctx.program({.stages = {"voxelize/splat.comp"}}) : 0;
+        if (!raster || !resolve || (splat && !splatter)) return;
         const kiln::TextureRef& out = ctx.output("radiance");
         const char* sums[4] = {"sum_r", "sum_g", "sum_b", "count"};
         const int res = out.width;
@@ -99,7 +109,7 @@ public:
         for (int i = 0; i < 4; ++i)
             glBindImageTexture(GLuint(i), ctx.internal(sums[i]).id, 0, GL_TRUE, 0, GL_READ_WRITE, GL_R32UI);
         uint32_t cats = kiln::kSceneBox | kiln::kSceneTumblers | kiln::kSceneFireballs;
-        if (ctx.getBool("particles")) cats |= kiln::kSceneParticles;
+        if (particles && !splat) cats |= kiln::kSceneParticles;
         if (ctx.getBool("marbles")) cats |= kiln::kSceneMarbles;
         const GLint emissionScale = glGetUniformLocation(raster, "u_emissionScale");
         glUniform1f(emissionScale, 1.0f);
@@ -107,6 +117,16 @@ public:
         glUniform1f(emissionScale, ctx.getFloat("lamp_emission"));
         ctx.drawScene({.categories = kiln::kSceneLamp, .lod = kiln::Lod::Low});
         glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+
+        // The particles, splatted (the sums' image units are still bound).
+        const uint32_t particleCount = ctx.scene().counts[kiln::sceneCategoryIndex(kiln::kSceneParticles)];
+        if (splat && particleCount > 0) {
+            glUseProgram(splatter);
+            glUniform1ui(glGetUniformLocation(splatter, "u_first"), ctx.scene().firstInstance(kiln::kSceneParticles));
+            glUniform1ui(glGetUniformLocation(splatter, "u_particleCount"), particleCount);
+            glUniform1i(glGetUniformLocation(splatter, "u_res"), res);
+            glDispatchCompute((particleCount + 63) / 64, 1, 1);
+        }
 
         // 4: resolve the averages.
         glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
