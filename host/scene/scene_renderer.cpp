@@ -15,7 +15,7 @@ void SceneRenderer::buildMeshes(const SceneLook& look) {
         makeLampDome(look.lampCentre, look.lampRadius, 3, 1.0f),
         makeTumbler(look.tumblerB, look.tumblerT, look.tumblerAlpha, 48, 16),
         makeTumbler(look.tumblerB, look.tumblerT, look.tumblerAlpha, 12, 4),
-        makeUvSphere(32, 16),
+        makeUvSphere(24, 12),  // 7.5° a segment: the silhouette is within 0.9 % of the radius (0.3 px on a 35-px marble)
         makeUvSphere(10, 6),
         makeParticle(),
     };
