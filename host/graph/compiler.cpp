@@ -73,6 +73,11 @@ void checkTexture(const char* what, const TextureDecl& t, const PassDeclaration&
             if (t.size.width < 1 || t.size.height < 1 || (t.kind == TextureKind::Color3D && t.size.depth < 1))
                 problems.push_back(name + " has a fixed size with a side < 1");
             break;
+        case SizeRule::Mode::RelativeOverParam:
+            if (t.kind == TextureKind::Color3D)
+                problems.push_back(name + " is 3D but sized relative to the (2D) output");
+            if (!(t.size.scale > 0.0f)) problems.push_back(name + " has scale " + num(t.size.scale) + " (must be > 0)");
+            [[fallthrough]];
         case SizeRule::Mode::FromParam: {
             auto it = std::find_if(d.params.begin(), d.params.end(),
                                    [&](const ParamDecl& p) { return p.name == t.size.source; });
@@ -148,6 +153,7 @@ std::string textureKey(const TextureDecl& t) {
             s += "param:" + t.size.source + "*" + num(t.size.scale) + "x" + std::to_string(t.size.tiles);
             break;
         case SizeRule::Mode::FromInput: s += "input:" + t.size.source + "*" + num(t.size.scale); break;
+        case SizeRule::Mode::RelativeOverParam: s += "rel" + num(t.size.scale) + "/" + t.size.source; break;
     }
     return s + ":mips" + std::to_string(t.mips);
 }

@@ -143,6 +143,14 @@ Extent resolveSize(const TextureDecl& t, int outW, int outH, const ResolvedParam
             e.d = is3D ? s : 1;
             break;
         }
+        case SizeRule::Mode::RelativeOverParam: {
+            const int* divisor = params.get<int>(t.size.source);
+            const double scale = double(t.size.scale) / std::max(1, divisor ? *divisor : 1);
+            auto side = [&](int out) { return static_cast<int>(std::clamp<long>(std::lround(scale * out), 1, 1L << 30)); };
+            e.w = side(outW);
+            e.h = side(outH);
+            break;
+        }
         case SizeRule::Mode::FromInput: {
             if (!input) break;  // unbound optional input: its fallback is 1×1(×1)
             auto side = [&](int v) { return std::max(1, int(std::lround(v * double(t.size.scale)))); };
@@ -185,6 +193,13 @@ std::string describeSize(const TextureDecl& t, const ResolvedParams& params) {
             std::string d = "as input " + t.size.source;
             if (t.size.scale != 1.0f) d = std::to_string(t.size.scale).substr(0, 4) + "× " + d;
             return d;
+        }
+        case SizeRule::Mode::RelativeOverParam: {
+            const int* divisor = params.get<int>(t.size.source);
+            char buf[64];
+            std::snprintf(buf, sizeof buf, "%gx / %s (%d)", static_cast<double>(t.size.scale), t.size.source.c_str(),
+                          divisor ? *divisor : 1);
+            return buf;
         }
         case SizeRule::Mode::FromParam: {
             const int* side = params.get<int>(t.size.source);

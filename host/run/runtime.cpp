@@ -117,7 +117,9 @@ bool Runtime::setParam(const std::string& passId, const std::string& name, const
     const bool sizesATexture = [&] {
         for (const auto* list : {&planned.decl.outputs, &planned.decl.internals})
             for (const TextureDecl& t : *list)
-                if (t.size.mode == SizeRule::Mode::FromParam && t.size.source == name) return true;
+                if ((t.size.mode == SizeRule::Mode::FromParam || t.size.mode == SizeRule::Mode::RelativeOverParam) &&
+                    t.size.source == name)
+                    return true;
         return false;
     }();
     if (sizesATexture) {

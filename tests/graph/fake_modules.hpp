@@ -71,6 +71,13 @@ inline std::map<std::string, PassDeclaration> fakeModules() {
     m["float_size"]
         .output({"color", TextureKind::Color2D, Format::RGBA8, SizeRule::fromParam("size"), 1, ""})
         .param(floatParam("size", 1.0f, 0.0, 2.0));
+    // A divided-size output whose divisor is a float, and a 3D one sized by the picture.
+    m["float_divisor"]
+        .output({"color", TextureKind::Color2D, Format::RGBA8, SizeRule::relativeOverParam("stride"), 1, ""})
+        .param(floatParam("stride", 2.0f, 1.0, 4.0));
+    m["divided_volume"]
+        .output({"color", TextureKind::Color3D, Format::RGBA8, SizeRule::relativeOverParam("stride"), 1, ""})
+        .param(intParam("stride", 2, 1, 4));
     return m;
 }
 

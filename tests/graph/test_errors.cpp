@@ -245,6 +245,11 @@ TEST_CASE("output size from a bad parameter is reported against the module", "[e
     e = errorsOf(R"({ "output": "b.color", "passes": [ { "id": "b", "module": "float_size" } ] })");
     CHECK_THAT(e, Contains("passes[0].module: module \"float_size\" declares output \"color\" takes its size from "
                            "parameter \"size\", which is a float, not an int"));
+    e = errorsOf(R"({ "output": "b.color", "passes": [ { "id": "b", "module": "float_divisor" } ] })");
+    CHECK_THAT(e, Contains("module \"float_divisor\" declares output \"color\" takes its size from "
+                           "parameter \"stride\", which is a float, not an int"));
+    e = errorsOf(R"({ "output": "b.color", "passes": [ { "id": "b", "module": "divided_volume" } ] })");
+    CHECK_THAT(e, Contains("module \"divided_volume\" declares output \"color\" is 3D but sized relative to the (2D) output"));
 }
 
 TEST_CASE("all errors are collected, in file order", "[errors]") {

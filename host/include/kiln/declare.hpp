@@ -51,6 +51,8 @@ struct SizeRule {
                            // `tiles` such blocks side by side along x (a slab atlas)
         FromInput,         // the size of what is bound to input `source` (× scale per side;
                            // 1×1(×1) when an optional input is unbound)
+        RelativeOverParam, // scale × the graph's output size ÷ the int parameter `source`
+                           // (2D; e.g. a trace at 1/stride of the picture)
     };
     Mode mode = Mode::RelativeToOutput;
     float scale = 1.0f;
@@ -65,6 +67,9 @@ struct SizeRule {
     }
     static SizeRule fromInput(std::string slot, float scale = 1.0f) {
         return {Mode::FromInput, scale, 0, 0, 1, std::move(slot), 1};
+    }
+    static SizeRule relativeOverParam(std::string name, float scale = 1.0f) {
+        return {Mode::RelativeOverParam, scale, 0, 0, 1, std::move(name), 1};
     }
 };
 

@@ -49,8 +49,9 @@
 //              (black / white / flat normal / far depth). An unbound optional input
 //              reaches your shaders as `#define KILN_HAS_<SLOT> 0` (1 when bound).
 //   outputs    format, 2D/3D, size rule, mip count. Size rules: relative to the output
-//              size, fixed, a side taken from an int parameter (fromParam), or the size
-//              of what is bound to one of your inputs (fromInput).
+//              size, the output size divided by an int parameter (relativeOverParam),
+//              fixed, a side taken from an int parameter (fromParam), or the size of
+//              what is bound to one of your inputs (fromInput).
 //   internals  scratch textures (ping-pong, mip levels): allocated by the host, not
 //              bindable by other passes, listed in the debug view like outputs.
 //   params     name, type, default, range or choices: they drive the JSON validation
