@@ -12,14 +12,14 @@ public:
     kiln::PassDeclaration declare() const override {
         using namespace kiln;
         PassDeclaration d;
-        // The G-buffer inputs and `indirect` are read texel for texel (the output's size);
-        // the bloom and the shadow map are filtered lookups at any size.
+        // The G-buffer inputs are read texel for texel (the output's size); the indirect
+        // light, the bloom and the shadow map are filtered lookups at any size.
         d.input({.name = "albedo", .doc = "output-sized"})
             .input({.name = "normal", .doc = "output-sized"})
             .input({.name = "depth", .kind = TextureKind::Depth2D, .doc = "output-sized"})
             .input({.name = "emissive", .required = false, .fallback = Fallback::Black, .doc = "output-sized"})
             .input({.name = "shadow_map", .kind = TextureKind::Depth2D, .required = false})
-            .input({.name = "indirect", .required = false, .fallback = Fallback::Black, .doc = "output-sized"})
+            .input({.name = "indirect", .required = false, .fallback = Fallback::Black})
             .input({.name = "bloom", .required = false, .fallback = Fallback::Black})
             .output({.name = "color", .format = Format::RGBA8, .doc = "tonemapped, gamma-encoded final image"})
             .output({.name = "hdr", .format = Format::RGBA16F, .doc = "linear radiance before bloom, exposure and tonemapping"})

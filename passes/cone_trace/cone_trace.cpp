@@ -16,8 +16,10 @@
 // Anisotropic chains: bind voxel_mip.aniso to `aniso` (KILN_HAS_ANISO), and the iso
 // chain (always) to `voxels`: level 0 of every lookup comes from it.
 // trace_stride 2 or 4: trace one pixel in every 2×2 (4×4) block into the internal
-// `half` (`quarter`), with the traced surface's plane beside it, then a
-// depth/normal-aware upsample writes `indirect`. Indirect light is smooth on surfaces,
+// `samples`, with the traced surface's plane in `planes`, then a depth/normal-aware
+// upsample writes `indirect`. output_divisor 2: `indirect` is half the picture's size
+// and composite's bilinear lookup does the last step (the upsample is a full-screen
+// pass: at 720² it cost as much as the stride-4 trace). Indirect light is smooth on surfaces,
 // so the error stays small where a traced sample lies on the pixel's own surface
 // (measured against full resolution in tests/gi and against the path-traced
 // reference by kiln-bench-quality); silhouettes reach further for a matching sample.
@@ -119,15 +121,12 @@ public:
             .input({.name = "voxels", .kind = TextureKind::Color3D, .doc = "voxel_mip.iso (level 0 = voxelize.radiance)"})
             .input({.name = "aniso", .kind = TextureKind::Color3D, .required = false,
                     .doc = "voxel_mip.aniso: sample the directional chains"})
-            .output({.name = "indirect", .format = Format::RGBA16F, .doc = "rgb = indirect irradiance / π, a = AO"})
-            .internal({.name = "half", .format = Format::RGBA16F, .size = SizeRule::relative(0.5f),
-                       .doc = "trace_stride 2: the traced samples"})
-            .internal({.name = "half_plane", .format = Format::RGBA16F, .size = SizeRule::relative(0.5f),
-                       .doc = "trace_stride 2: each sample's surface, xyz = normal, w = n·p (0,0,0 off geometry)"})
-            .internal({.name = "quarter", .format = Format::RGBA16F, .size = SizeRule::relative(0.25f),
-                       .doc = "trace_stride 4: the traced samples"})
-            .internal({.name = "quarter_plane", .format = Format::RGBA16F, .size = SizeRule::relative(0.25f),
-                       .doc = "trace_stride 4: each sample's surface"})
+            .output({.name = "indirect", .format = Format::RGBA16F, .size = SizeRule::relativeOverParam("output_divisor"),
+                     .doc = "rgb = indirect irradiance / π, a = AO; the output's size ÷ output_divisor"})
+            .internal({.name = "samples", .format = Format::RGBA16F, .size = SizeRule::relativeOverParam("trace_stride"),
+                       .doc = "trace_stride > 1: the traced samples"})
+            .internal({.name = "planes", .format = Format::RGBA16F, .size = SizeRule::relativeOverParam("trace_stride"),
+                       .doc = "trace_stride > 1: each sample's surface, xyz = normal, w = n·p (0,0,0 off geometry)"})
             .param(intChoiceParam("cones", 6, {1, 5, 6, 9, 16}, "diffuse cones per pixel"))
             .param(floatParam("aperture", 60.0f, 5.0, 150.0, "cone opening angle, degrees"))
             .param(floatParam("max_distance", 2.0f, 0.1, 3.5, "cone length, world units (box side = 2)"))
@@ -139,6 +138,8 @@ public:
                               "each sample pushed off the surface by this × its diameter (against self-occlusion)"))
             .param(intChoiceParam("trace_stride", 1, {1, 2, 4},
                                   "trace one pixel per N×N block and upsample (depth/normal aware); 1 = every pixel"))
+            .param(intChoiceParam("output_divisor", 1, {1, 2},
+                                  "2: upsample to half resolution; composite's bilinear lookup does the last 2×"))
             .param(floatParam("upsample_tolerance", 0.02f, 0.001, 1.0, "plane distance (world) that halves a sample's weight"));
         d.reads = kSceneCamera;
         return d;
@@ -151,15 +152,19 @@ public:
         GLuint upsample = ctx.program({.stages = {"common/fullscreen.vert", "cone_trace/upsample.frag"}});
         if (!trace || !upsample) return;
         const int stride = ctx.getInt("trace_stride");
-        const char* samples = stride == 4 ? "quarter" : "half";
-        const char* planes = stride == 4 ? "quarter_plane" : "half_plane";
+        // An `indirect` pixel covers `divisor` G-buffer texels per side. A trace no
+        // sparser than that goes straight into it (one texel per pixel); a sparser one
+        // goes into `samples` and is upsampled.
+        const int divisor = ctx.getInt("output_divisor");
+        const bool upsampled = stride > divisor;
+        const int traceStep = upsampled ? stride : divisor;
 
         glBindTextureUnit(0, ctx.input("normal").id);
         glBindTextureUnit(1, ctx.input("depth").id);
         glBindTextureUnit(2, voxels.id);
         glBindTextureUnit(3, ctx.input("aniso").id);
 
-        if (!(stride > 1 ? ctx.framebuffer({samples, planes}) : ctx.framebuffer({"indirect"}))) return;
+        if (!(upsampled ? ctx.framebuffer({"samples", "planes"}) : ctx.framebuffer({"indirect"}))) return;
         glUseProgram(trace);
         const std::vector<float> cones = coneSet(ctx.getInt("cones"));
         auto loc = [&](const char* n) { return glGetUniformLocation(trace, n); };
@@ -169,15 +174,16 @@ public:
         glUniform1f(loc("u_startOffset"), ctx.getFloat("start_offset"));
         glUniform1f(loc("u_diameterOffset"), ctx.getFloat("diameter_offset"));
         glUniform1f(loc("u_voxelRes"), float(voxels.width));
-        glUniform1i(loc("u_stride"), stride);
+        glUniform1i(loc("u_stride"), traceStep);
         ctx.drawFullscreenTriangle();
 
-        if (stride > 1) {
+        if (upsampled) {
             if (!ctx.framebuffer({"indirect"})) return;
             glUseProgram(upsample);
-            glBindTextureUnit(4, ctx.internal(samples).id);
-            glBindTextureUnit(5, ctx.internal(planes).id);
+            glBindTextureUnit(4, ctx.internal("samples").id);
+            glBindTextureUnit(5, ctx.internal("planes").id);
             glUniform1i(glGetUniformLocation(upsample, "u_stride"), stride);
+            glUniform1i(glGetUniformLocation(upsample, "u_outputStep"), divisor);
             glUniform1f(glGetUniformLocation(upsample, "u_planeTolerance"), ctx.getFloat("upsample_tolerance"));
             ctx.drawFullscreenTriangle();
         }

@@ -42,7 +42,8 @@ vec3 worldPosition(vec2 uv, float depth) {
 }
 
 void main() {
-    // Every input but the bloom is the output's size: texel fetches, no filtering.
+    // The G-buffer inputs are the output's size: texel fetches. The indirect light and
+    // the bloom may be smaller (cone_trace.output_divisor, bloom at half size): filtered.
     ivec2 px = ivec2(gl_FragCoord.xy);
     vec4 n4 = texelFetch(u_normal, px, 0);
     // The optional ones may be the 1×1 fallback: clamped.
@@ -55,7 +56,7 @@ void main() {
         vec3 irradiance = lampLight(p, n);
         float visible = max(irradiance.r, max(irradiance.g, irradiance.b)) > 0.0 ? lightVisibility(p + n * 0.004) : 0.0;
         vec3 direct = albedo / 3.14159265 * irradiance * visible;
-        vec3 indirect = albedo * u_indirectStrength * texelFetch(u_indirect, min(px, textureSize(u_indirect, 0) - 1), 0).rgb;
+        vec3 indirect = albedo * u_indirectStrength * texture(u_indirect, v_uv).rgb;
 #if KILN_HAS_INDIRECT == 0
         indirect = albedo * u_ambient;
 #endif

@@ -1,5 +1,7 @@
 #version 450 core
-// Depth- and normal-aware upsample of a strided trace: each output pixel blends the
+// Depth- and normal-aware upsample of a strided trace, to full or half resolution
+// (u_outputStep; half: each output pixel stands for one G-buffer texel of its 2×2
+// block and composite's bilinear lookup does the rest). Each output pixel blends the
 // 2×2 nearest samples with bilinear weights × how well each sample's surface matches
 // its own: normal agreement (cos⁸) and the pixel's distance from the sample's tangent
 // plane (the plane comes with the sample, so a tap is two fetches and no matrix).
@@ -14,7 +16,8 @@ layout(binding = 0) uniform sampler2D u_normal;
 layout(binding = 1) uniform sampler2D u_depth;
 layout(binding = 4) uniform sampler2D u_samples;
 layout(binding = 5) uniform sampler2D u_planes;
-uniform int u_stride;
+uniform int u_stride;      // G-buffer texels per sample (per side)
+uniform int u_outputStep;  // G-buffer texels per output pixel: 1, or 2 for a half-size output
 uniform float u_planeTolerance;  // world units
 
 layout(location = 0) out vec4 o_indirect;
@@ -28,7 +31,8 @@ float surfaceMatch(vec3 n, vec3 p, ivec2 h) {
 }
 
 void main() {
-    ivec2 px = ivec2(gl_FragCoord.xy);
+    // The G-buffer texel this output pixel stands for (its own one, or one of its 2×2).
+    ivec2 px = traceTexel(ivec2(gl_FragCoord.xy), u_outputStep);
     vec4 n4 = texelFetch(u_normal, px, 0);
     if (n4.w < 0.5) {
         o_indirect = vec4(0.0, 0.0, 0.0, 1.0);
