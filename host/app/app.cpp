@@ -90,12 +90,13 @@ std::optional<uint64_t> App::seedOverride() const {
 }
 
 SceneView App::buildView() {
+    const glm::mat4 view = camera_.view();
+    const glm::mat4 proj = camera_.projection(float(options_.width) / float(options_.height));
     scene_.writeTo(renderer_, scene_.sim().dragged());
+    renderer_.setViewer(camera_.position(), proj[1][1] * 0.5f * float(options_.height));
     renderer_.upload();
 
     SceneView v;
-    const glm::mat4 view = camera_.view();
-    const glm::mat4 proj = camera_.projection(float(options_.width) / float(options_.height));
     v.frame.view = view;
     v.frame.proj = proj;
     v.frame.viewProj = proj * view;

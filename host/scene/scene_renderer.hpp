@@ -48,6 +48,14 @@ struct ParticleInstance {
     glm::vec3 emissive;
 };
 
+// The sphere mesh for a marble or fireball whose radius spans `radiusPx` pixels on
+// screen: 0 = 32 segments around, 1 = 16, 2 = 10 (the voxelization mesh). A polygon of
+// n segments strays from its circle by r·(1 − cos(π/n)); the thresholds keep that under
+// a pixel up to a 200-px radius (tests/integration/test_scene.cpp).
+constexpr float kSphereNearPx = 48.0f, kSphereFarPx = 12.0f;
+inline int sphereLevelFor(float radiusPx) { return radiusPx >= kSphereNearPx ? 0 : radiusPx >= kSphereFarPx ? 1 : 2; }
+inline constexpr int kSphereSegments[3] = {32, 16, 10};
+
 class SceneRenderer final : public run::SceneDraw {
 public:
     // (Re)builds every mesh (the lamp dome and the tumblers follow the look) and the
@@ -55,6 +63,9 @@ public:
     void setLook(const SceneLook&);
     void setBodies(const std::vector<BodyInstance>&);
     void setParticles(const std::vector<ParticleInstance>&);
+    // The camera, for the spheres' level of detail: its position and the pixels a unit
+    // length spans at unit distance (projection[1][1] × height / 2).
+    void setViewer(glm::vec3 eye, float pixelsPerUnit);
     // Uploads what changed; call once per frame before the passes run.
     void upload();
     // Instanced draws of every group matching the filter with the current program.
@@ -66,12 +77,15 @@ public:
     uint64_t version(SceneCategory single) const { return versions_[sceneCategoryIndex(single)]; }
 
 private:
-    enum MeshId { kQuad, kLamp, kTumblerHigh, kTumblerLow, kSphereHigh, kSphereLow, kParticle, kMeshCount };
+    enum MeshId { kQuad, kLamp, kTumblerHigh, kTumblerLow, kSphereHigh, kSphereMid, kSphereLow, kParticle, kMeshCount };
     struct MeshRange { uint32_t firstIndex = 0, indexCount = 0, baseVertex = 0; };
     struct Group { MeshId mesh; SceneCategory category; Lod lod; bool anyLod; uint32_t first, count; };
 
     void buildMeshes(const SceneLook&);
     void rebuildGroups();
+    // Orders each sphere category's instances near → mid → far by their size on
+    // screen; returns the three counts per category (marbles, fireballs).
+    void sortSpheresBySize();
     void noteContents(SceneCategory, const GpuInstance* begin, size_t count);
 
     std::array<MeshRange, kMeshCount> meshes_{};
@@ -81,6 +95,9 @@ private:
     size_t instanceCapacity_ = 0;
     std::vector<GpuInstance> staticInstances_, bodyInstances_, particleInstances_;
     std::vector<Group> groups_;
+    glm::vec3 eye_{0.0f};
+    float pixelsPerUnit_ = 0.0f;
+    std::array<std::array<uint32_t, 3>, 2> sphereLevels_{};  // marbles, fireballs: near, mid, far
     bool dirty_ = true;
     uint32_t counts_[kSceneGeometryCount] = {};
     uint64_t versions_[kSceneGeometryCount] = {};

@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
@@ -11,6 +12,7 @@
 #include "app/app.hpp"
 #include "kiln/image_io.hpp"
 #include "support/golden.hpp"
+#include "scene/scene_renderer.hpp"
 #include "support/headless.hpp"
 
 namespace fs = std::filesystem;
@@ -166,4 +168,25 @@ TEST_CASE("bloom glows below the brightest emitter's luminance and is exactly bl
     REQUIRE(rig.app.runtime().loadPipelineText(bloomPipeline(1.01f * brightest), "bloom.json", errors));
     rig.app.frame();
     CHECK(maxLuminance(rig.app, "bloom", "bloom") == 0.0f);
+}
+
+TEST_CASE("sphere level of detail: the silhouette stays within a pixel of the circle up to a 200-px radius",
+          "[scene]") {
+    // Independent of the thresholds' own comment: the largest gap between an n-segment
+    // polygon and its circle is r·(1 − cos(π/n)) (the sagitta at a segment's middle).
+    // Walk radii on screen from 0.5 to 200 px and check the chosen mesh against it.
+    auto sagittaPx = [](float radiusPx, int segments) { return radiusPx * (1.0 - std::cos(M_PI / segments)); };
+    double worst = 0;
+    for (float r = 0.5f; r <= 200.0f; r *= 1.01f) {
+        const int level = scene::sphereLevelFor(r);
+        REQUIRE(level >= 0);
+        REQUIRE(level <= 2);
+        worst = std::max(worst, sagittaPx(r, scene::kSphereSegments[level]));
+        // Never finer than needed by more than one level: a 20-px marble is not drawn at 32.
+        if (r < scene::kSphereNearPx) CHECK(scene::kSphereSegments[level] < 32);
+    }
+    INFO("worst silhouette error " << worst << " px");
+    CHECK(worst < 1.0);
+    CHECK(worst > 0.5);  // and the coarse meshes are really used near their limits
+    CHECK(scene::sphereLevelFor(500.0f) == 0);
 }

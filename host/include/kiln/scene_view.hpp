@@ -13,6 +13,9 @@
 
 namespace kiln {
 
+// High: as fine as the picture needs (marbles and fireballs pick one of three sphere
+// meshes per instance by their size on screen); Low: the coarse meshes, for passes that
+// see the scene at low resolution (voxelize).
 enum class Lod : uint8_t { High, Low };
 
 // What drawScene() draws: the geometry bits of SceneCategory (kSceneGeometry,
