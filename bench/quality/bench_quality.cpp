@@ -2,15 +2,17 @@
 // is running, frozen at a chosen time. A command, not a test: it prints a table and
 // writes CSV.
 //
-//   kiln-bench-quality [--pipeline FILE] [--scene FILE] [--time SECONDS] [--size WxH]
-//                      [--spp N] [--frames N] [--repeats R] [--sweep PASS.PARAM=V1,V2,...]...
-//                      [--cartesian] [--out DIR]
+//   kiln-bench-quality [--pipeline FILE] [--also FILE]... [--scene FILE] [--time SECONDS]
+//                      [--size WxH] [--spp N] [--frames N] [--repeats R]
+//                      [--sweep PASS.PARAM=V1,V2,...]... [--cartesian] [--out DIR]
 //
 // 1. Steps the scene to --time and freezes it.
 // 2. The reference (passes/reference) at --spp paths per pixel, cached as OpenEXR in
 //    DIR/cache/ under a hash of the scene file, time, size and sample count (progress
 //    and ETA on stderr while it renders).
-// 3. The pipeline once as it is ("default") and once per value of each --sweep (one
+// 3. The pipeline once as it is ("default"), each --also pipeline as it is (labelled by
+//    its file name, e.g. pipelines/seed.json: before and after in one run), and once
+//    per value of each --sweep (one
 //    knob at a time around the default, or every combination with --cartesian; without
 //    --sweep, the documented subset below).
 //    Per setting: GPU ms per pass (timer queries, medians over --frames with every pass
@@ -26,6 +28,7 @@
 //    setting beats on both; plots every setting, the front and the default
 //    (DIR/quality.png, log-log).
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -50,12 +53,14 @@ using namespace kiln::bench;
 namespace {
 
 // The documented subset swept when no --sweep is given: the knobs the seed's report
-// discusses (voxel resolution, mips, cones, aperture, step schedule, half/full
-// resolution) and the shadow filter and map size.
+// discusses (voxel resolution, mips, cones, aperture, step schedule, trace stride)
+// and the shadow filter and map size, the indirect output's size, the lamp's
+// quadrature.
 const char* const kDefaultSweeps[] = {
     "voxelize.resolution=32,64,128", "voxel_mip.mode=iso,aniso",     "cone_trace.cones=1,5,6,9,16",
     "cone_trace.aperture=30,45,60,90", "cone_trace.schedule=octave,continuous", "cone_trace.trace_stride=1,2,4",
     "composite.pcf=1,3,5,9",          "shadow.size=512,1024,2048,4096",
+    "cone_trace.output_divisor=1,2",  "composite.lamp_samples=8,16,32",
 };
 
 struct Args {
@@ -64,6 +69,7 @@ struct Args {
     double time = 0.5;
     int width = 128, height = 128, spp = 256, frames = 5, repeats = 3;
     std::vector<std::string> sweeps;
+    std::vector<std::string> also;  // more pipelines, measured as they are
     bool cartesian = false;  // every combination of the sweeps, not one knob at a time
     std::string outDir = "bench-out";
 };
@@ -88,6 +94,7 @@ Args parseArgs(int argc, char** argv) {
             return int(n);
         };
         if (a == "--pipeline") args.pipeline = next();
+        else if (a == "--also") args.also.push_back(next());
         else if (a == "--scene") args.scene = next();
         else if (a == "--time") {
             const std::string v = next();
@@ -106,7 +113,7 @@ Args parseArgs(int argc, char** argv) {
         else if (a == "--sweep") args.sweeps.push_back(next());
         else if (a == "--out") args.outDir = next();
         else if (a == "--help" || a == "-h") {
-            std::printf("usage: kiln-bench-quality [--pipeline FILE] [--scene FILE] [--time S] [--size WxH] [--spp N]\n"
+            std::printf("usage: kiln-bench-quality [--pipeline FILE] [--also FILE]... [--scene FILE] [--time S] [--size WxH] [--spp N]\n"
                         "                          [--frames N] [--repeats R] [--sweep PASS.PARAM=V1,V2,...]... [--cartesian]\n"
                         "                          [--out DIR]\n");
             std::exit(0);
@@ -119,6 +126,7 @@ Args parseArgs(int argc, char** argv) {
 struct Setting {
     std::string label;
     std::vector<Override> overrides;
+    std::string pipeline;  // empty: --pipeline
 };
 
 // The default, then either each sweep's values one knob at a time, or (--cartesian)
@@ -136,6 +144,7 @@ std::vector<Setting> settingsOf(const Args& args) {
             axes.back().push_back({base.pass + "." + base.param + "=" + v, {{base.pass, base.param, v}}});
     }
     std::vector<Setting> settings{{"default", {}}};
+    for (auto& file : args.also) settings.push_back({fs::path(file).stem().string(), {}, file});
     if (!args.cartesian) {
         for (auto& axis : axes) settings.insert(settings.end(), axis.begin(), axis.end());
         return settings;
@@ -245,8 +254,9 @@ struct Result {
 bool measure(app::App& app, const Args& args, const Setting& setting, const FloatImage& ref, const FloatImage& refDirect,
              Result& r) {
     std::string text, error;
-    if (!applyOverrides(slurp(args.pipeline), setting.overrides, text, error) ||
-        !app.runtime().loadPipelineText(text, args.pipeline, error))
+    const std::string& pipeline = setting.pipeline.empty() ? args.pipeline : setting.pipeline;
+    if (!applyOverrides(slurp(pipeline), setting.overrides, text, error) ||
+        !app.runtime().loadPipelineText(text, pipeline, error))
         return fail(setting.label + ": " + error);
     app.runtime().setRequested({"composite.hdr", "gbuffer.emissive", "gbuffer.depth"});
     app.runtime().alwaysRun = true;
@@ -376,14 +386,20 @@ int main(int argc, char** argv) {
     PlotSeries all{"settings", {150, 150, 150}, {}, false, 3}, front{"Pareto front", {200, 40, 40}, {}, true, 4},
         defaults{"default", {30, 90, 220}, {}, false, 7};
     std::vector<const Result*> onFront;
+    std::vector<PlotSeries> others;  // one highlighted point per --also pipeline
+    const std::array<uint8_t, 3> otherColors[] = {{230, 140, 20}, {40, 160, 70}, {140, 60, 170}};
     for (auto& r : results) {
         all.points.emplace_back(r.totalMs, r.errors.relMse);
         if (r.pareto) onFront.push_back(&r);
         if (r.label == "default") defaults.points.emplace_back(r.totalMs, r.errors.relMse);
+        for (size_t i = 0; i < args.also.size(); ++i)
+            if (r.label == fs::path(args.also[i]).stem().string())
+                others.push_back({r.label, otherColors[i % 3], {{r.totalMs, r.errors.relMse}}, false, 7});
     }
     std::sort(onFront.begin(), onFront.end(), [](auto* a, auto* b) { return a->totalMs < b->totalMs; });
     for (auto* r : onFront) front.points.emplace_back(r->totalMs, r->errors.relMse);
     plot.series = {all, front, defaults};
+    plot.series.insert(plot.series.end(), others.begin(), others.end());
     const std::string pngPath = (fs::path(args.outDir) / "quality.png").string();
     if (!writeLogLogPng(pngPath, plot, error)) return fail(error) ? 0 : 1;
     std::printf("\n* = on the Pareto front of (GPU ms, relative MSE)\nwrote %s and %s\n", csvPath.c_str(), pngPath.c_str());
