@@ -19,10 +19,10 @@
 // `samples`, with the traced surface's plane in `planes`, then a depth/normal-aware
 // upsample writes `indirect`. output_divisor 2: `indirect` is half the picture's size
 // and composite's bilinear lookup does the last step (the upsample is a full-screen
-// pass: at 720² it cost as much as the stride-4 trace). Indirect light is smooth on surfaces,
-// so the error stays small where a traced sample lies on the pixel's own surface
-// (measured against full resolution in tests/gi and against the path-traced
-// reference by kiln-bench-quality); silhouettes reach further for a matching sample.
+// pass: at 720² it cost as much as the stride-4 trace). Indirect light is smooth on
+// surfaces, so the error stays small where a traced sample lies on the pixel's own
+// surface (measured against full resolution in tests/gi and against the path-traced
+// reference by kiln-bench-quality); at silhouettes the nearest sample stands in.
 #include <kiln/pass.hpp>
 
 #include <algorithm>
