@@ -15,6 +15,9 @@ public:
             .output({.name = "emissive", .format = Format::RGBA16F, .doc = "emitted radiance"})
             .output({.name = "depth", .kind = TextureKind::Depth2D, .format = Format::Depth32F,
                      .depthNear = kCameraNear, .depthFar = kCameraFar})
+            .internal({.name = "wood", .format = Format::RGBA8, .size = SizeRule::fixed(1024, 1024),
+                       .mips = kFullMipChain,
+                       .doc = "the floor's grain baked over x, z in [-1,1] (2 mm texels), re-baked when its colours change"})
             .param(boolParam("particles", true, "draw the particles"))
             .param(enumParam("particle_mode", "points", {"points", "mesh"},
                              "points: one point sprite per particle, shaded as a sphere; mesh: its octahedron"));
@@ -31,7 +34,22 @@ public:
         const bool particles = ctx.getBool("particles");
         const bool points = particles && ctx.getEnum("particle_mode") == "points";
         GLuint pointProgram = points ? ctx.program({.stages = {"gbuffer/particle.vert", "gbuffer/particle.frag"}}) : 0;
-        if (!program || (points && !pointProgram)) return;
+        GLuint bake = ctx.program({.stages = {"gbuffer/wood.comp"}});
+        if (!program || !bake || (points && !pointProgram)) return;
+        // The floor's grain, baked: sampled through its mips it is the grain averaged
+        // over each pixel, as the reference sees it (at 256²: floor relMSE 0.058
+        // against 0.075 evaluated at pixel centres, SSIM 0.789 against 0.772), for
+        // +1.6 ms at 720². Re-baked when the wood colours or the texture change.
+        const kiln::TextureRef& wood = ctx.internal("wood");
+        const auto& f = ctx.scene().frame;
+        if (wood.id != bakedTexture_ || f.woodLight != bakedLight_ || f.woodDark != bakedDark_ || bake != bakedWith_) {
+            glUseProgram(bake);
+            glBindImageTexture(0, wood.id, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA8);
+            glDispatchCompute(GLuint((wood.width + 7) / 8), GLuint((wood.height + 7) / 8), 1);
+            glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
+            glGenerateTextureMipmap(wood.id);
+            bakedTexture_ = wood.id, bakedLight_ = f.woodLight, bakedDark_ = f.woodDark, bakedWith_ = bake;
+        }
         if (!ctx.framebuffer({"albedo", "normal", "emissive"}, "depth")) return;
         const float zero[4] = {0, 0, 0, 0}, one = 1.0f;
         for (int i = 0; i < 3; ++i) glClearBufferfv(GL_COLOR, i, zero);
@@ -39,6 +57,7 @@ public:
         glEnable(GL_DEPTH_TEST);
         glDepthFunc(GL_LESS);
         glUseProgram(program);
+        glBindTextureUnit(1, wood.id);
         kiln::DrawFilter filter;
         filter.categories = kiln::kSceneGeometry;
         if (!particles || points) filter.categories &= ~kiln::kSceneParticles;
@@ -61,6 +80,9 @@ public:
 
 private:
     GLuint pointsVao_ = 0;  // attribute-less: the vertex shader reads the instance buffer
+    // What the wood texture was last baked from (a cache: a reload starts over).
+    GLuint bakedTexture_ = 0, bakedWith_ = 0;
+    glm::vec4 bakedLight_{-1.0f}, bakedDark_{-1.0f};
 };
 
 }  // namespace

@@ -2,7 +2,8 @@
 // G-buffer: albedo (sRGB-free linear rgb), world-space normal, emitted radiance.
 #include "common/frame.glsl"
 #include "common/instances.glsl"
-#include "common/wood.glsl"
+
+layout(binding = 1) uniform sampler2D u_wood;  // the floor's grain over x, z in [-1,1] (gbuffer/wood.comp)
 
 in vec3 v_world;
 in vec3 v_normal;
@@ -15,7 +16,7 @@ layout(location = 2) out vec4 o_emissive;  // rgb radiance
 void main() {
     KilnInstance inst = kiln_instances[v_instance];
     vec3 albedo = inst.albedo.rgb;
-    if (inst.albedo.a > 0.5) albedo = woodGrain(v_world);
+    if (inst.albedo.a > 0.5) albedo = texture(u_wood, v_world.xz * 0.5 + 0.5).rgb;
     vec3 n = normalize(v_normal);
     if (!gl_FrontFacing) n = -n;
     vec3 emissive = inst.emissive.rgb;

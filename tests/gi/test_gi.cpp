@@ -278,6 +278,44 @@ TEST_CASE("gbuffer: particles drawn as points cover what their meshes cover, whe
     CHECK(light[1] == Approx(light[0]).epsilon(0.05));
 }
 
+TEST_CASE("gbuffer: the baked floor grain follows the scene's wood colours, re-baked on reload", "[gi][gbuffer]") {
+    // Light and dark wood set to one colour: every floor pixel's albedo is that colour
+    // whatever the grain (RGBA8: within 1/255 plus rounding). Reloading the scene with
+    // another colour must re-bake: the albedo follows.
+    const char* scenes[2] = {
+        R"({"tumblers": [], "marbles": [], "fireballs": [],
+            "box": {"floor_wood": {"light": [0.2, 0.4, 0.6], "dark": [0.2, 0.4, 0.6], "ring_frequency": 14}}})",
+        R"({"tumblers": [], "marbles": [], "fireballs": [],
+            "box": {"floor_wood": {"light": [0.7, 0.1, 0.3], "dark": [0.7, 0.1, 0.3], "ring_frequency": 14}}})"};
+    const glm::vec3 expected[2] = {{0.2f, 0.4f, 0.6f}, {0.7f, 0.1f, 0.3f}};
+    Rig rig(writeScene("wood_a.json", scenes[0]), 96);
+    rig.load(pipeline("gbuffer.albedo", R"({"id": "gbuffer", "module": "gbuffer"})"), {"gbuffer.depth"});
+    for (int round = 0; round < 2; ++round) {
+        if (round == 1) {
+            std::string error;
+            INFO(error);
+            REQUIRE(rig.app.scene().load(writeScene("wood_b.json", scenes[1]), std::nullopt, error));
+        }
+        rig.app.frame();
+        rig.checkNoErrors();
+        const FloatImage albedo = rig.image("gbuffer", "albedo"), depth = rig.image("gbuffer", "depth");
+        int floorPixels = 0;
+        float worst = 0;
+        for (int y = 0; y < 96; ++y)
+            for (int x = 0; x < 96; ++x) {
+                if (depth.at(x, y)[0] >= 1.0f) continue;
+                // The floor (y = −1), away from the walls' bottom edges.
+                const glm::vec3 w = worldOf(rig, depth, x, y);
+                if (std::abs(w.y + 1.0f) > 0.01f || std::abs(w.x) > 0.95f || std::abs(w.z) > 0.95f) continue;
+                ++floorPixels;
+                for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(albedo.at(x, y)[c] - expected[round][c]));
+            }
+        INFO("round " << round << ": " << floorPixels << " floor pixels, worst channel error " << worst);
+        CHECK(floorPixels > 500);
+        CHECK(worst <= 2.0f / 255.0f);
+    }
+}
+
 TEST_CASE("voxel_mip: every level of a constant volume equals it (iso and all six directions)", "[gi][mip]") {
     // Tolerance 2e-3: RGBA16F stores 0.6 with a spacing of 2^-11·0.6 ≈ 3e-4, and an
     // average of equal values (or a composite over an opaque front) is that value.
