@@ -20,7 +20,7 @@ void main() {
     for (int k = 0; k < 4; ++k) {
         vec3 c = texelFetch(u_color, min(2 * q + ivec2(k & 1, k >> 1), size - 1), 0).rgb;
         float l = dot(c, vec3(0.2126, 0.7152, 0.0722));
-        m = max(m, l);  // NaN never wins
+        if (l > m) m = l;  // NaN never wins (GLSL's max() leaves NaN undefined)
         sum += l > u_threshold ? c * ((l - u_threshold) / l) : vec3(0.0);
     }
     if (all(lessThan(q, imageSize(u_bright)))) imageStore(u_bright, q, vec4(0.25 * sum, 1.0));
