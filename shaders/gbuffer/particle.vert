@@ -1,7 +1,7 @@
 #version 450 core
 // Particles as points: one vertex per particle (instances [u_first, u_first + count) of
-// the scene's instance buffer, model = translate × scale(radius)), sized to the
-// sphere's projected diameter; particle.frag makes each a shaded disc.
+// the scene's instance buffer), sized to the sphere's projected diameter;
+// particle.frag makes each a shaded disc.
 #include "common/frame.glsl"
 #include "common/instances.glsl"
 
@@ -10,9 +10,8 @@ flat out uint v_instance;
 
 void main() {
     KilnInstance inst = kiln_instances[u_first + uint(gl_VertexID)];
-    vec3 centre = inst.model[3].xyz;
-    float radius = length(inst.model[0].xyz);
-    gl_Position = u_viewProj * vec4(centre, 1.0);
+    float radius = kilnSphereRadius(inst);
+    gl_Position = u_viewProj * vec4(kilnSphereCentre(inst), 1.0);
     // Diameter in pixels: 2r · (focal length in pixels) / depth.
     gl_PointSize = max(2.0 * radius * u_proj[1][1] * 0.5 * u_outputSize.y / max(gl_Position.w, 1e-4), 1.0);
     v_instance = u_first + uint(gl_VertexID);

@@ -9,7 +9,7 @@ layout(r32ui, binding = 2) uniform readonly uimage3D u_sumB;
 layout(r32ui, binding = 3) uniform readonly uimage3D u_count;
 layout(rgba16f, binding = 4) uniform writeonly image3D u_radiance;
 
-const float kFixedScale = 512.0;  // keep in sync with voxelize.frag
+const float kFixedScale = 512.0;  // keep in sync with sums.glsl
 
 void main() {
     ivec3 v = ivec3(gl_GlobalInvocationID);

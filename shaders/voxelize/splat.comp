@@ -3,32 +3,25 @@
 // its emitted radiance, as one fragment would, to every voxel its bounding box
 // overlaps (one voxel for a particle smaller than a voxel, at most 2×2×2), into the
 // same fixed-point sums and count as voxelize.frag, so resolve.comp averages it with
-// the surfaces around it. The particles are the instances
-// [u_first, u_first + u_particleCount) of the scene's instance buffer (model = translate ×
-// scale(radius)); they are emitters with no albedo, so no lamp light and no shadow
-// test. Cost: a few atomics per particle, where rasterizing the mesh cost a geometry
-// shader invocation per triangle.
+// the surfaces around it. The particles are the instances [u_first, u_first +
+// u_particleCount) of the scene's instance buffer; they are emitters with no albedo,
+// so no lamp light and no shadow test. Cost: a few atomics per particle, where
+// rasterizing the mesh cost a geometry shader invocation per triangle.
 #include "common/instances.glsl"
+#include "sums.glsl"
 
 layout(local_size_x = 64) in;
-layout(r32ui, binding = 0) uniform coherent uimage3D u_sumR;
-layout(r32ui, binding = 1) uniform coherent uimage3D u_sumG;
-layout(r32ui, binding = 2) uniform coherent uimage3D u_sumB;
-layout(r32ui, binding = 3) uniform coherent uimage3D u_count;
 
 uniform uint u_first;
 uniform uint u_particleCount;
 uniform int u_res;
 
-const float kFixedScale = 512.0;   // keep in sync with voxelize.frag and resolve.comp
-const float kMaxRadiance = 2048.0;
-
 void main() {
     if (gl_GlobalInvocationID.x >= u_particleCount) return;
     KilnInstance inst = kiln_instances[u_first + gl_GlobalInvocationID.x];
-    vec3 centre = inst.model[3].xyz;
-    float radius = length(inst.model[0].xyz);
-    uvec3 fixedRgb = uvec3(clamp(inst.emissive.rgb, 0.0, kMaxRadiance) * kFixedScale + 0.5);
+    vec3 centre = kilnSphereCentre(inst);
+    float radius = kilnSphereRadius(inst);
+    uvec3 fixedRgb = toFixedRadiance(inst.emissive.rgb);
     // Voxel index range of the bounding box, at most two voxels per axis.
     ivec3 lo = ivec3(floor(((centre - radius) * 0.5 + 0.5) * float(u_res)));
     ivec3 hi = min(ivec3(floor(((centre + radius) * 0.5 + 0.5) * float(u_res))), lo + 1);
@@ -36,11 +29,5 @@ void main() {
     hi = min(hi, ivec3(u_res - 1));
     for (int z = lo.z; z <= hi.z; ++z)
         for (int y = lo.y; y <= hi.y; ++y)
-            for (int x = lo.x; x <= hi.x; ++x) {
-                ivec3 v = ivec3(x, y, z);
-                imageAtomicAdd(u_sumR, v, fixedRgb.r);
-                imageAtomicAdd(u_sumG, v, fixedRgb.g);
-                imageAtomicAdd(u_sumB, v, fixedRgb.b);
-                imageAtomicAdd(u_count, v, 1u);
-            }
+            for (int x = lo.x; x <= hi.x; ++x) addToVoxel(ivec3(x, y, z), fixedRgb);
 }

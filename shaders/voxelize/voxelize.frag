@@ -7,6 +7,7 @@
 #include "common/instances.glsl"
 #include "common/light.glsl"
 #include "common/wood.glsl"
+#include "sums.glsl"
 
 in vec3 v_world;
 in vec3 v_normal;
@@ -16,17 +17,10 @@ flat in vec4 v_aabb;
 flat in vec2 v_depthRange;
 
 layout(binding = 0) uniform sampler2D u_shadowMap;
-layout(r32ui, binding = 0) uniform coherent uimage3D u_sumR;
-layout(r32ui, binding = 1) uniform coherent uimage3D u_sumG;
-layout(r32ui, binding = 2) uniform coherent uimage3D u_sumB;
-layout(r32ui, binding = 3) uniform coherent uimage3D u_count;
 
 uniform int u_res;
 uniform float u_shadowBias;
 uniform float u_emissionScale;  // 1, or lamp_emission while drawing the lamp
-
-const float kFixedScale = 512.0;   // keep in sync with resolve.comp
-const float kMaxRadiance = 2048.0;
 
 void main() {
     vec2 px = gl_FragCoord.xy;
@@ -41,7 +35,7 @@ void main() {
     vis = shadowHard(u_shadowMap, v_world + n * (2.0 / float(u_res)), u_shadowBias);
 #endif
     vec3 radiance = albedo / 3.14159265 * lampLight(v_world, n) * vis + inst.emissive.rgb * u_emissionScale;
-    uvec3 fixedRgb = uvec3(clamp(radiance, 0.0, kMaxRadiance) * kFixedScale + 0.5);
+    uvec3 fixedRgb = toFixedRadiance(radiance);
 
     // Depth along the projection axis at this pixel, and how much it varies across it.
     float depth = v_axis == 0 ? v_world.x : v_axis == 1 ? v_world.y : v_world.z;
@@ -53,10 +47,6 @@ void main() {
     ivec2 ij = clamp(ivec2(px), ivec2(0), ivec2(u_res - 1));
     for (int k = k0; k <= min(k1, k0 + 2); ++k) {
         // Back from (2D, depth) to (x, y, z): the inverse of the geometry shader's swizzle.
-        ivec3 v = v_axis == 0 ? ivec3(k, ij.x, ij.y) : v_axis == 1 ? ivec3(ij.y, k, ij.x) : ivec3(ij, k);
-        imageAtomicAdd(u_sumR, v, fixedRgb.r);
-        imageAtomicAdd(u_sumG, v, fixedRgb.g);
-        imageAtomicAdd(u_sumB, v, fixedRgb.b);
-        imageAtomicAdd(u_count, v, 1u);
+        addToVoxel(v_axis == 0 ? ivec3(k, ij.x, ij.y) : v_axis == 1 ? ivec3(ij.y, k, ij.x) : ivec3(ij, k), fixedRgb);
     }
 }
