@@ -84,7 +84,7 @@ private:
     void buildMeshes(const SceneLook&);
     void rebuildGroups();
     // Orders each sphere category's instances near → mid → far by their size on
-    // screen; returns the three counts per category (marbles, fireballs).
+    // screen and keeps the three counts in sphereLevels_.
     void sortSpheresBySize();
     void noteContents(SceneCategory, const GpuInstance* begin, size_t count);
 

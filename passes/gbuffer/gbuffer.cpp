@@ -65,7 +65,7 @@ public:
 
         // Thousands of particles a few pixels wide: one point each, not 8 triangles
         // (4 000 octahedra cost the G-buffer 15 ms at 720² on llvmpipe).
-        const uint32_t count = ctx.scene().counts[kiln::sceneCategoryIndex(kiln::kSceneParticles)];
+        const uint32_t count = ctx.scene().count(kiln::kSceneParticles);
         if (points && count > 0) {
             if (!pointsVao_) glCreateVertexArrays(1, &pointsVao_);
             glUseProgram(pointProgram);

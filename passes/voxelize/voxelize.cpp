@@ -119,7 +119,7 @@ public:
         glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
 
         // The particles, splatted (the sums' image units are still bound).
-        const uint32_t particleCount = ctx.scene().counts[kiln::sceneCategoryIndex(kiln::kSceneParticles)];
+        const uint32_t particleCount = ctx.scene().count(kiln::kSceneParticles);
         if (splat && particleCount > 0) {
             glUseProgram(splatter);
             glUniform1ui(glGetUniformLocation(splatter, "u_first"), ctx.scene().firstInstance(kiln::kSceneParticles));
