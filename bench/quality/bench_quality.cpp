@@ -93,9 +93,16 @@ Args parseArgs(int argc, char** argv) {
             if (*end || n < 1 || n > 1 << 20) usageError(a + " " + v + ": expected a positive integer");
             return int(n);
         };
-        if (a == "--pipeline") args.pipeline = next();
-        else if (a == "--also") args.also.push_back(next());
-        else if (a == "--scene") args.scene = next();
+        // Files are checked here: the reference renders before any pipeline loads, for
+        // minutes.
+        auto file = [&]() {
+            std::string path = next();
+            if (!fs::is_regular_file(path)) usageError(a + " " + path + ": cannot read the file");
+            return path;
+        };
+        if (a == "--pipeline") args.pipeline = file();
+        else if (a == "--also") args.also.push_back(file());
+        else if (a == "--scene") args.scene = file();
         else if (a == "--time") {
             const std::string v = next();
             char* end = nullptr;

@@ -126,7 +126,16 @@ Args parseArgs(int argc, char** argv) {
 // bodies like its first one (or a default), on a 5 × 4 × 5 lattice over the upper box
 // (x, z in ±0.64, y in [0.0, 0.75]), each with its own deterministic velocity.
 std::string grownScene(const std::string& sceneFile, const std::string& kind, int count, const std::string& outDir) {
-    Json scene = Json::parse(slurp(sceneFile));
+    // The scene loader checks the rest when the grown file loads; here only what
+    // growing needs: a readable JSON object.
+    if (!fs::is_regular_file(sceneFile)) usageError("--grow: " + sceneFile + ": cannot read the scene file");
+    Json scene;
+    try {
+        scene = Json::parse(slurp(sceneFile));
+    } catch (const Json::exception& e) {
+        usageError("--grow: " + sceneFile + ": " + e.what());
+    }
+    if (!scene.is_object()) usageError("--grow: " + sceneFile + ": not a JSON object");
     Json like = scene.contains(kind) && !scene[kind].empty() ? scene[kind][0] : Json::object();
     if (!like.contains("radius")) like["radius"] = 0.05;
     if (!like.contains("color")) like["color"] = {1.0, 0.5, 0.1};
@@ -183,7 +192,6 @@ struct Measured {
     std::vector<std::string> order;                  // pass ids in plan order
     std::map<std::string, std::vector<double>> gpu, cpu;  // per-round medians
     std::vector<double> frameMs, particles;
-    int bodies = 0;
 };
 
 // One round of `config`: a fresh app, --settle seconds simulated, 3 warm-up frames,

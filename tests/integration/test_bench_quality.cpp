@@ -1,10 +1,13 @@
 // kiln-bench-quality at 32×32 (a tiny sweep): one CSV row per setting, every value
 // finite, a Pareto front, and the reference served from its cache the second time.
+// kiln-bench-render --grow at 32×32: one growth row per count. Bad arguments are named
+// usage errors before anything renders.
 #include <catch2/catch.hpp>
 
 #include <cmath>
 #include <filesystem>
 #include <sstream>
+#include <vector>
 
 #include "support/run_kiln.hpp"
 
@@ -14,7 +17,8 @@ TEST_CASE("kiln-bench-quality: a tiny sweep writes one finite CSV row per settin
           "[integration][bench]") {
     const std::string out = std::string(TEST_OUTPUT_DIR) + "/bench-quality";
     std::filesystem::remove_all(out);
-    const std::string args = "--size 32x32 --spp 8 --frames 1 --repeats 2 --time 0.1 --sweep cone_trace.cones=1,9 --out " + out;
+    const std::string args = "--size 32x32 --spp 8 --frames 1 --repeats 2 --time 0.1 --sweep cone_trace.cones=1,9 "
+                             "--also pipelines/seed.json --out " + out;
     Run first = runProgram(KILN_BENCH_QUALITY, args, 300);
     INFO(first.out << first.err);
     REQUIRE(first.exitCode == 0);
@@ -23,9 +27,10 @@ TEST_CASE("kiln-bench-quality: a tiny sweep writes one finite CSV row per settin
     std::getline(csv, line);
     CHECK(line == "setting,total_gpu_ms,rmse,rel_mse,ssim,psnr,pixels,pareto,rel_mse_indirect,rel_mse_floor,rel_mse_walls,"
                   "rel_mse_ceiling,rel_mse_objects,pass_ms");
-    int rows = 0, front = 0;
+    int rows = 0, front = 0, seedRows = 0;
     while (std::getline(csv, line)) {
         ++rows;
+        seedRows += line.rfind("\"seed\",", 0) == 0;
         // "label",ms,rmse,relmse,ssim,psnr,pixels,pareto,indirect,floor,walls,ceiling,objects,"passes"
         std::istringstream cells(line.substr(line.find("\",") + 2));
         double v[12];
@@ -42,9 +47,65 @@ TEST_CASE("kiln-bench-quality: a tiny sweep writes one finite CSV row per settin
         for (int k = 7; k < 12; ++k) CHECK(v[k] > 0.0);
         CHECK(line.find("cone_trace=") != std::string::npos);
     }
-    CHECK(rows == 3);  // default + 2 sweep values
+    CHECK(rows == 4);  // default, seed (--also), 2 sweep values
+    CHECK(seedRows == 1);
     CHECK(front >= 1);
     Run second = runProgram(KILN_BENCH_QUALITY, args, 300);
     CHECK(second.exitCode == 0);
     CHECK(second.out.find("(cached)") != std::string::npos);
+}
+
+TEST_CASE("kiln-bench-quality: a pipeline or scene file it cannot read is a usage error before the reference renders",
+          "[integration][bench]") {
+    for (const char* option : {"--also", "--pipeline", "--scene"}) {
+        Run r = runProgram(KILN_BENCH_QUALITY, std::string(option) + " no/such/file.json", 60);
+        INFO(r.out << r.err);
+        CHECK(r.exitCode == 2);
+        CHECK(r.err.find(std::string(option) + " no/such/file.json: cannot read the file") != std::string::npos);
+        CHECK(r.out.find("reference") == std::string::npos);
+    }
+}
+
+TEST_CASE("kiln-bench-render --grow: one growth row per count, the first the baseline; bad arguments are named",
+          "[integration][bench]") {
+    const std::string out = std::string(TEST_OUTPUT_DIR) + "/bench-grow";
+    std::filesystem::remove_all(out);
+    Run r = runProgram(KILN_BENCH_RENDER,
+                       "--size 32x32 --frames 1 --repeats 1 --settle 0.3 --grow fireballs=0,4 --out " + out, 300);
+    INFO(r.out << r.err);
+    REQUIRE(r.exitCode == 0);
+    std::istringstream csv(slurp(out + "/growth.csv"));
+    std::string line;
+    std::getline(csv, line);
+    CHECK(line == "pipeline,fireballs,particles,frame_ms,ratio,voxelize_ms,gbuffer_ms,shadow_ms");
+    std::vector<std::vector<double>> rows;
+    while (std::getline(csv, line)) {
+        std::istringstream cells(line.substr(line.find(',') + 1));
+        std::vector<double> v(7);
+        char comma;
+        for (double& x : v) cells >> x >> comma;
+        rows.push_back(v);
+    }
+    REQUIRE(rows.size() == 2);
+    CHECK(rows[0][0] == 0);
+    CHECK(rows[1][0] == 4);
+    CHECK(rows[0][1] == 0);   // no fireball, no fire
+    CHECK(rows[1][1] > 0);    // 0.3 s of four fireballs: particles
+    CHECK(rows[0][3] == 1.0); // the baseline's ratio
+    for (auto& v : rows)
+        for (double x : v) CHECK(std::isfinite(x));
+    CHECK(std::filesystem::file_size(out + "/growth.png") > 1000);
+    // The grown scene files are what the simulation loaded: four fireballs in the second.
+    CHECK(slurp(out + "/scene-fireballs-4.json").find("\"fireballs\"") != std::string::npos);
+
+    for (const char* bad : {"--grow comets=1", "--grow fireballs=x", "--grow fireballs=-1", "--settle 99"}) {
+        Run b = runProgram(KILN_BENCH_RENDER, std::string(bad) + " --out " + out, 60);
+        INFO(bad << ": " << b.err);
+        CHECK(b.exitCode == 2);
+        CHECK(b.err.find("kiln-bench-render: error: " + std::string(bad).substr(0, std::string(bad).find(' '))) !=
+              std::string::npos);
+    }
+    Run missing = runProgram(KILN_BENCH_RENDER, "--scene no/such.json --grow fireballs=1 --out " + out, 60);
+    CHECK(missing.exitCode == 2);
+    CHECK(missing.err.find("no/such.json: cannot read the scene file") != std::string::npos);
 }
