@@ -94,6 +94,19 @@ void checkTexture(const char* what, const TextureDecl& t, const PassDeclaration&
             if (!(t.size.scale > 0.0f)) problems.push_back(name + " has scale " + num(t.size.scale) + " (must be > 0)");
             break;
     }
+    if (!t.producedWhen.param.empty()) {
+        auto it = std::find_if(d.params.begin(), d.params.end(),
+                               [&](const ParamDecl& p) { return p.name == t.producedWhen.param; });
+        if (it == d.params.end() || it->type != ParamType::Enum)
+            problems.push_back(name + " is produced when " + q(t.producedWhen.param) + " has some values, but " +
+                               (it == d.params.end() ? "there is no such parameter" : "it is not an enum"));
+        else
+            for (const std::string& v : t.producedWhen.values)
+                if (std::find(it->choices.begin(), it->choices.end(), v) == it->choices.end())
+                    problems.push_back(name + " is produced when " + q(t.producedWhen.param) + " is " + q(v) +
+                                       ", which is not one of its choices");
+    }
+    if (t.size.tiles < 1) problems.push_back(name + " has " + std::to_string(t.size.tiles) + " tiles (must be >= 1)");
     if (t.mips < 0) problems.push_back(name + " has a negative mip count");
 }
 
@@ -152,7 +165,9 @@ std::string textureKey(const TextureDecl& t) {
         case SizeRule::Mode::FromParam:
             s += "param:" + t.size.source + "*" + num(t.size.scale) + "x" + std::to_string(t.size.tiles);
             break;
-        case SizeRule::Mode::FromInput: s += "input:" + t.size.source + "*" + num(t.size.scale); break;
+        case SizeRule::Mode::FromInput:
+            s += "input:" + t.size.source + "*" + num(t.size.scale) + "x" + std::to_string(t.size.tiles);
+            break;
         case SizeRule::Mode::RelativeOverParam: s += "rel" + num(t.size.scale) + "/" + t.size.source; break;
     }
     return s + ":mips" + std::to_string(t.mips);
@@ -508,6 +523,18 @@ private:
             passError(i, path, "input " + q(slot) + " expects a " + toString(in->kind) + " texture, but " + q(text) +
                                    " is " + describe(*out));
             return;
+        }
+        if (const ProducedWhen& when = out->producedWhen; !when.param.empty()) {
+            const std::string* value = plan_.passes[static_cast<size_t>(j)].params.get<std::string>(when.param);
+            if (value && std::find(when.values.begin(), when.values.end(), *value) == when.values.end()) {
+                std::string values;
+                for (size_t k = 0; k < when.values.size(); ++k)
+                    values += (k == 0 ? "" : k + 1 == when.values.size() ? " or " : ", ") + q(when.values[k]);
+                passError(i, path, q(text) + " is filled only when " + q(producerId) + "'s " + when.param + " is " +
+                                       values + "; it is " + q(*value) + " (" + passPath(j) + ".params." +
+                                       when.param + ")");
+                return;
+            }
         }
         Binding& b = *std::find_if(pp.bindings.begin(), pp.bindings.end(),
                                    [&](const Binding& x) { return x.slot == slot; });

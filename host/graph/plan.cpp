@@ -154,7 +154,7 @@ Extent resolveSize(const TextureDecl& t, int outW, int outH, const ResolvedParam
         case SizeRule::Mode::FromInput: {
             if (!input) break;  // unbound optional input: its fallback is 1×1(×1)
             auto side = [&](int v) { return std::max(1, int(std::lround(v * double(t.size.scale)))); };
-            e.w = side(input->w);
+            e.w = side(input->w) * std::max(1, t.size.tiles);
             e.h = side(input->h);
             e.d = is3D ? side(input->d) : 1;
             break;
@@ -192,6 +192,7 @@ std::string describeSize(const TextureDecl& t, const ResolvedParams& params) {
         case SizeRule::Mode::FromInput: {
             std::string d = "as input " + t.size.source;
             if (t.size.scale != 1.0f) d = std::to_string(t.size.scale).substr(0, 4) + "× " + d;
+            if (t.size.tiles > 1) d += " ×" + std::to_string(t.size.tiles) + " tiles";
             return d;
         }
         case SizeRule::Mode::RelativeOverParam: {

@@ -114,15 +114,19 @@ bool Runtime::setParam(const std::string& passId, const std::string& name, const
         error = passId + ".params." + name + ": " + problem;
         return false;
     }
-    const bool sizesATexture = [&] {
+    // A parameter that sizes a texture, or decides whether an output is filled (which a
+    // binding may need), goes through the whole compiler: an invalid graph is refused
+    // and the running one kept.
+    const bool shapesThePlan = [&] {
         for (const auto* list : {&planned.decl.outputs, &planned.decl.internals})
             for (const TextureDecl& t : *list)
-                if ((t.size.mode == SizeRule::Mode::FromParam || t.size.mode == SizeRule::Mode::RelativeOverParam) &&
-                    t.size.source == name)
+                if (((t.size.mode == SizeRule::Mode::FromParam || t.size.mode == SizeRule::Mode::RelativeOverParam) &&
+                     t.size.source == name) ||
+                    t.producedWhen.param == name)
                     return true;
         return false;
     }();
-    if (sizesATexture) {
+    if (shapesThePlan) {
         graph::PipelineDesc edited = *desc_;
         graph::setParamLiteral(edited.passes[size_t(descIndex)], name, *checked);
         return loadPipelineDesc(std::move(edited), error);

@@ -58,7 +58,8 @@ inline std::map<std::string, PassDeclaration> fakeModules() {
     // Outputs sized like an input: a half-size copy of a 3D volume (voxel_mip's shape).
     m["halve"]
         .input({"volume", TextureKind::Color3D, true, Fallback::Black, ""})
-        .output({"half", TextureKind::Color3D, Format::RGBA16F, SizeRule::fromInput("volume", 0.5f), 1, ""});
+        .output({"half", TextureKind::Color3D, Format::RGBA16F, SizeRule::fromInput("volume", 0.5f), 1, ""})
+        .output({"strip", TextureKind::Color3D, Format::RGBA16F, SizeRule::fromInput("volume", 0.5f, 12), 1, ""});
     m["input_sized_wrong"]
         .input({"volume", TextureKind::Color3D, true, Fallback::Black, ""})
         .output({"copy", TextureKind::Color3D, Format::RGBA16F, SizeRule::fromInput("volum"), 1, ""});

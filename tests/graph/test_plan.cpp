@@ -203,6 +203,10 @@ TEST_CASE("fromInput sizes follow the producer through the bindings", "[plan][si
     CHECK(plan->extentOf(plan->find("h2"), "half", 640, 480) == Extent{32, 32, 32});
     CHECK(plan->extentOf(plan->find("gbuffer"), "albedo", 640, 480) == Extent{640, 480, 1});
     CHECK(describeSize(*plan->passes[size_t(plan->find("h1"))].output("half"), {}) == "0.50× as input volume");
+    // Tiles side by side along x (voxel_mip's fixed-cone strip: 12 half-size cubes).
+    CHECK(plan->extentOf(plan->find("h1"), "strip", 640, 480) == Extent{12 * 64, 64, 64});
+    CHECK(describeSize(*plan->passes[size_t(plan->find("h1"))].output("strip"), {}) ==
+          "0.50× as input volume ×12 tiles");
     // Unknown pass or texture: the 1×1×1 of "nothing".
     CHECK(plan->extentOf(99, "half", 640, 480) == Extent{});
     CHECK(plan->extentOf(plan->find("h1"), "nope", 640, 480) == Extent{});

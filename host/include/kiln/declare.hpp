@@ -50,7 +50,8 @@ struct SizeRule {
         FromParam,         // a square (2D) or cube (3D) whose side is an int parameter × scale;
                            // `tiles` such blocks side by side along x (a slab atlas)
         FromInput,         // the size of what is bound to input `source` (× scale per side;
-                           // 1×1(×1) when an optional input is unbound)
+                           // 1×1(×1) when an optional input is unbound); `tiles` such
+                           // blocks side by side along x
         RelativeOverParam, // scale × the graph's output size ÷ the int parameter `source`
                            // (2D; e.g. a trace at 1/stride of the picture)
     };
@@ -65,8 +66,8 @@ struct SizeRule {
     static SizeRule fromParam(std::string name, float scale = 1.0f, int tiles = 1) {
         return {Mode::FromParam, scale, 0, 0, 1, std::move(name), tiles};
     }
-    static SizeRule fromInput(std::string slot, float scale = 1.0f) {
-        return {Mode::FromInput, scale, 0, 0, 1, std::move(slot), 1};
+    static SizeRule fromInput(std::string slot, float scale = 1.0f, int tiles = 1) {
+        return {Mode::FromInput, scale, 0, 0, 1, std::move(slot), tiles};
     }
     static SizeRule relativeOverParam(std::string name, float scale = 1.0f) {
         return {Mode::RelativeOverParam, scale, 0, 0, 1, std::move(name), 1};
@@ -84,6 +85,14 @@ struct InputDecl {
     std::string doc;
 };
 
+// An output that only some values of one enum parameter fill (voxel_mip's chains, by
+// mode). Binding it while the parameter has another value is a pipeline error naming
+// the values that fill it, not a black texture. Empty `param`: always filled.
+struct ProducedWhen {
+    std::string param;
+    std::vector<std::string> values;
+};
+
 struct TextureDecl {  // an output (bindable by later passes) or an internal texture
     std::string name;
     TextureKind kind = TextureKind::Color2D;
@@ -94,6 +103,7 @@ struct TextureDecl {  // an output (bindable by later passes) or an internal tex
     // Depth written through a perspective projection: its near and far planes, so a
     // viewer can show linear distance (both 0: orthographic or unknown, shown as stored).
     float depthNear = 0.0f, depthFar = 0.0f;
+    ProducedWhen producedWhen;  // outputs only
 };
 
 enum class ParamType : uint8_t { Bool, Int, Float, Enum, Color };

@@ -51,7 +51,9 @@
 //   outputs    format, 2D/3D, size rule, mip count. Size rules: relative to the output
 //              size, the output size divided by an int parameter (relativeOverParam),
 //              fixed, a side taken from an int parameter (fromParam), or the size of
-//              what is bound to one of your inputs (fromInput).
+//              what is bound to one of your inputs (fromInput). An output that only some
+//              values of an enum parameter fill says so (producedWhen): binding it
+//              otherwise is a pipeline error.
 //   internals  scratch textures (ping-pong, mip levels): allocated by the host, not
 //              bindable by other passes, listed in the debug view like outputs.
 //   params     name, type, default, range or choices: they drive the JSON validation
@@ -128,7 +130,7 @@
 namespace kiln {
 
 // Bump when anything in this header (or what it includes) changes layout or vtables.
-inline constexpr uint32_t kPassAbiVersion = 4;
+inline constexpr uint32_t kPassAbiVersion = 5;
 
 struct TextureRef {
     GLuint id = 0;
