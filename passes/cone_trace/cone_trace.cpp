@@ -15,6 +15,11 @@
 //
 // Anisotropic chains: bind voxel_mip.aniso to `aniso` (KILN_HAS_ANISO), and the iso
 // chain (always) to `voxels`: level 0 of every lookup comes from it.
+// Fixed cones: bind voxel_mip.fixed_cones (mode fixed_cones) to `fixed_cones` instead
+// of `aniso`. The cones are then the same for every pixel: the 12 directions of an
+// icosahedron (shaders/common/fixed_cones.glsl), of which a surface traces the 6 (4 on
+// the box's axis-aligned walls) in its hemisphere, weighted by cos θ; `cones` must be 6. Each step is one fetch from chains voxel_mip blended per direction, not three:
+// the anisotropic result at the cost of an isotropic lookup.
 // trace_stride 2 or 4: trace one pixel in every 2×2 (4×4) block into the internal
 // `samples`, with the traced surface's plane in `planes`, then a depth/normal-aware
 // upsample writes `indirect`. output_divisor 2: `indirect` is half the picture's size
@@ -121,13 +126,16 @@ public:
             .input({.name = "voxels", .kind = TextureKind::Color3D, .doc = "voxel_mip.iso (level 0 = voxelize.radiance)"})
             .input({.name = "aniso", .kind = TextureKind::Color3D, .required = false,
                     .doc = "voxel_mip.aniso: sample the directional chains"})
+            .input({.name = "fixed_cones", .kind = TextureKind::Color3D, .required = false,
+                    .doc = "voxel_mip.fixed_cones: trace the fixed cone set, one fetch per step (instead of aniso)"})
             .output({.name = "indirect", .format = Format::RGBA16F, .size = SizeRule::relativeOverParam("output_divisor"),
                      .doc = "rgb = indirect irradiance / π, a = AO; the output's size ÷ output_divisor"})
             .internal({.name = "samples", .format = Format::RGBA16F, .size = SizeRule::relativeOverParam("trace_stride"),
                        .doc = "trace_stride > 1: the traced samples"})
             .internal({.name = "planes", .format = Format::RGBA16F, .size = SizeRule::relativeOverParam("trace_stride"),
                        .doc = "trace_stride > 1: each sample's surface, xyz = normal, w = n·p (0,0,0 off geometry)"})
-            .param(intChoiceParam("cones", 6, {1, 5, 6, 9, 16}, "diffuse cones per pixel"))
+            .param(intChoiceParam("cones", 6, {1, 5, 6, 9, 16},
+                                  "diffuse cones per pixel, around the normal (with fixed_cones bound: 6, the fixed set)"))
             .param(floatParam("aperture", 60.0f, 5.0, 150.0, "cone opening angle, degrees"))
             .param(floatParam("max_distance", 2.0f, 0.1, 3.5, "cone length, world units (box side = 2)"))
             .param(enumParam("schedule", "octave", {"octave", "continuous"},
@@ -146,6 +154,12 @@ public:
     }
 
     void execute(kiln::PassContext& ctx) override {
+        if (ctx.isBound("aniso") && ctx.isBound("fixed_cones"))
+            return ctx.fail("bind `aniso` or `fixed_cones`, not both: they are two ways of tracing the cones");
+        if (ctx.isBound("fixed_cones") && ctx.getInt("cones") != 6)
+            return ctx.fail("cones " + std::to_string(ctx.getInt("cones")) +
+                            ": the fixed set traces 6 cones a pixel (4 on axis-aligned walls); set 6, or bind "
+                            "`aniso` instead of `fixed_cones` for other counts");
         const kiln::TextureRef& voxels = ctx.input("voxels");
         GLuint trace = ctx.program({.stages = {"common/fullscreen.vert", "cone_trace/cone_trace.frag"},
                                     .defines = schedule(ctx, voxels.width)});
@@ -163,6 +177,7 @@ public:
         glBindTextureUnit(1, ctx.input("depth").id);
         glBindTextureUnit(2, voxels.id);
         glBindTextureUnit(3, ctx.input("aniso").id);
+        glBindTextureUnit(6, ctx.input("fixed_cones").id);
 
         if (!(upsampled ? ctx.framebuffer({"samples", "planes"}) : ctx.framebuffer({"indirect"}))) return;
         glUseProgram(trace);

@@ -19,8 +19,19 @@
 //          PERFORMANCE.md: six samplers behind a ?: cost ~7 fetches on llvmpipe).
 //          The sampler must clamp coordinates half a texel inside the octant
 //          (shaders/cone_trace/voxels.glsl does).
-// In iso mode the aniso atlas is cleared to zero once and left alone.
+//   fixed_cones  (mode = fixed_cones) the aniso chains blended per direction of the
+//          fixed cone set (shaders/common/fixed_cones.glsl, 12 directions): tile t of
+//          level k is what a cone along direction t reads at directional level k+1,
+//          i.e. Σ d²·(the three chains facing d). Filtering is linear, so one lookup
+//          here equals cone_trace's three; the blend costs 12 writes per voxel of
+//          levels ≥ 1 (1/7 of the volume) once per voxel change instead of two more
+//          fetches per cone step per pixel.
+// Chains a mode does not build are cleared to zero once and left alone; binding one
+// is a pipeline error (producedWhen), so no cone reads them.
 #include <kiln/pass.hpp>
+
+#include <algorithm>
+#include <string>
 
 namespace {
 
@@ -35,18 +46,29 @@ public:
                      .mips = kFullMipChain, .doc = "isotropic chain; level 0 = the input"})
             .output({.name = "aniso", .kind = TextureKind::Color3D, .format = Format::RGBA16F, .size = cube,
                      .mips = kFullMipChain,
-                     .doc = "six directional chains as octants; atlas level k = directional level k+1"})
-            .param(enumParam("mode", "aniso", {"iso", "aniso"}, "build the anisotropic chains too"));
+                     .doc = "six directional chains as octants; atlas level k = directional level k+1",
+                     .producedWhen = {"mode", {"aniso", "fixed_cones"}}})
+            .output({.name = "fixed_cones", .kind = TextureKind::Color3D, .format = Format::RGBA16F,
+                     .size = SizeRule::fromInput("radiance", 0.5f, 12), .mips = kFullMipChain,
+                     .doc = "the aniso chains blended for each of the 12 fixed cone directions (tiles along x); "
+                            "level k = directional level k+1",
+                     .producedWhen = {"mode", {"fixed_cones"}}})
+            .param(enumParam("mode", "aniso", {"iso", "aniso", "fixed_cones"},
+                             "iso: the isotropic chain only; aniso: the six directional chains too; "
+                             "fixed_cones: those blended per fixed cone direction as well"));
         return d;
     }
 
     void execute(kiln::PassContext& ctx) override {
         GLuint iso = ctx.program({.stages = {"voxel_mip/iso.comp"}});
         GLuint aniso = ctx.program({.stages = {"voxel_mip/aniso.comp"}});
-        if (!iso || !aniso) return;
+        GLuint blend = ctx.program({.stages = {"voxel_mip/fixed_cones.comp"}});
+        if (!iso || !aniso || !blend) return;
         const kiln::TextureRef& in = ctx.input("radiance");
         const kiln::TextureRef& chain = ctx.output("iso");
         const kiln::TextureRef& atlas = ctx.output("aniso");
+        const kiln::TextureRef& fixed = ctx.output("fixed_cones");
+        const std::string& mode = ctx.getEnum("mode");
         const int res = chain.width;  // = the input's (SizeRule::fromInput)
         glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
         glCopyImageSubData(in.id, GL_TEXTURE_3D, 0, 0, 0, 0, chain.id, GL_TEXTURE_3D, 0, 0, 0, 0, res, res, res);
@@ -61,7 +83,7 @@ public:
             glDispatchCompute(groups(n), groups(n), groups(n));
         }
 
-        if (ctx.getEnum("mode") == "aniso") {
+        if (mode != "iso") {
             glUseProgram(aniso);
             // Directional level L (1 … log2 res) lives in atlas level L−1, octant side res>>L.
             for (int L = 1; (res >> L) >= 1; ++L) {
@@ -78,8 +100,24 @@ public:
             }
             atlasCleared_ = false;
         } else if (!atlasCleared_) {
-            for (int l = 0; l < atlas.levels; ++l) glClearTexImage(atlas.id, l, GL_RGBA, GL_FLOAT, nullptr);
+            clearAllLevels(atlas);
             atlasCleared_ = true;
+        }
+
+        if (mode == "fixed_cones") {
+            glUseProgram(blend);
+            for (int L = 1; (res >> L) >= 1; ++L) {
+                const int n = res >> L;
+                glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+                glBindImageTexture(0, atlas.id, L - 1, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA16F);
+                glBindImageTexture(1, fixed.id, L - 1, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA16F);
+                glUniform1i(glGetUniformLocation(blend, "u_size"), n);
+                glDispatchCompute(groups(n), groups(n), groups(n));
+            }
+            fixedCleared_ = false;
+        } else if (!fixedCleared_) {
+            clearAllLevels(fixed);
+            fixedCleared_ = true;
         }
         glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
         glBindImageTexture(0, 0, 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA16F);
@@ -87,7 +125,12 @@ public:
     }
 
 private:
-    bool atlasCleared_ = false;  // a cache flag only
+    static void clearAllLevels(const kiln::TextureRef& t) {
+        for (int l = 0; l < t.levels; ++l) glClearTexImage(t.id, l, GL_RGBA, GL_FLOAT, nullptr);
+    }
+
+    bool atlasCleared_ = false;  // cache flags only
+    bool fixedCleared_ = false;
 };
 
 }  // namespace

@@ -1,30 +1,50 @@
 // Sampling the mipped voxel radiance (passes/voxel_mip): quadrilinear lookups (trilinear
 // inside a level, linear between levels) of premultiplied colour + opacity over the
-// box [-1,1]³. With KILN_HAS_ANISO the cone direction picks three of the six
-// directional chains by sign arithmetic, weighted by d² (three fetches, one sampler);
-// below level 1 it blends in the isotropic base (level 0 has no directions).
+// box [-1,1]³. Below level 1 every mode blends in the isotropic base (level 0 has no
+// directions). From level 1:
+//   KILN_HAS_FIXED_CONES  the cone is direction `tile` of the fixed set: one fetch from
+//                         voxel_mip.fixed_cones (the directional chains pre-blended).
+//   KILN_HAS_ANISO        the direction d picks three of the six directional chains by
+//                         sign arithmetic, weighted by d² (three fetches, one sampler).
+//   neither               the isotropic chain.
 //
-// Needs: u_voxels (iso chain, level 0 = voxelize.radiance), u_aniso (the octant
-// atlas), u_voxelRes (voxels per side at level 0).
+// Needs: u_voxels (iso chain, level 0 = voxelize.radiance), u_aniso (the octant atlas)
+// or u_fixedCones (the tile strip), u_voxelRes (voxels per side at level 0).
 layout(binding = 2) uniform sampler3D u_voxels;
 layout(binding = 3) uniform sampler3D u_aniso;
+layout(binding = 6) uniform sampler3D u_fixedCones;
 uniform float u_voxelRes;
 
-// p01: position in [0,1]³; d: unit direction of travel; lod: level in base voxels
-// (0 = res, 1 = res/2, ...). Uniform-per-step lod keeps the branch below coherent.
-vec4 sampleVoxels(vec3 p01, vec3 d, float lod) {
-#if KILN_HAS_ANISO
+#if KILN_HAS_FIXED_CONES
+#include "common/fixed_cones.glsl"
+#endif
+
+// Clamped half a texel inside one directional block (an octant or a tile) whose side at
+// level 1 is res/2, at atlas level al: a lookup never blends in its neighbour.
+vec3 insideBlock(vec3 p01, float al) {
+    float side = max(0.5 * u_voxelRes / exp2(ceil(al)), 1.0);  // the coarser level used
+    return clamp(p01, vec3(0.5 / side), vec3(1.0 - 0.5 / side));
+}
+
+// p01: position in [0,1]³; d: unit direction of travel; tile: its index in the fixed
+// set (KILN_HAS_FIXED_CONES only); lod: level in base voxels (0 = res, 1 = res/2, ...).
+// Uniform-per-step lod keeps the branches below coherent.
+vec4 sampleVoxels(vec3 p01, vec3 d, int tile, float lod) {
+#if KILN_HAS_ANISO || KILN_HAS_FIXED_CONES
     vec4 base = vec4(0.0);
     if (lod < 1.0) base = textureLod(u_voxels, p01, 0.0);
     if (lod <= 0.0) return base;
-    float al = max(lod - 1.0, 0.0);                       // atlas level
-    float octTexels = max(0.5 * u_voxelRes / exp2(ceil(al)), 1.0);  // octant side at the coarser level used
-    vec3 q = clamp(p01, vec3(0.5 / octTexels), vec3(1.0 - 0.5 / octTexels));
+    float al = max(lod - 1.0, 0.0);  // atlas level
+    vec3 q = insideBlock(p01, al);
+#if KILN_HAS_FIXED_CONES
+    vec4 s = textureLod(u_fixedCones, vec3((float(tile) + q.x) / float(kFixedConeTiles), q.y, q.z), al);
+#else
     vec3 neg = vec3(lessThan(d, vec3(0.0)));
     vec3 w = d * d;
     vec4 s = w.x * textureLod(u_aniso, (vec3(neg.x, 0.0, 0.0) + q) * 0.5, al)
            + w.y * textureLod(u_aniso, (vec3(neg.y, 1.0, 0.0) + q) * 0.5, al)
            + w.z * textureLod(u_aniso, (vec3(neg.z, 0.0, 1.0) + q) * 0.5, al);
+#endif
     return lod < 1.0 ? mix(base, s, lod) : s;
 #else
     return textureLod(u_voxels, p01, lod);

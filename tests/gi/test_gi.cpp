@@ -36,6 +36,33 @@ Volume read3d(const TextureRef& t, int level) {
     return vol;
 }
 
+// A whole level of a 3D RGBA texture of any shape (a tile strip), x fastest.
+struct Block {
+    int w = 0, h = 0, d = 0;
+    std::vector<float> v;
+    const float* at(int x, int y, int z) const { return &v[((size_t(z) * h + y) * w + x) * 4]; }
+};
+Block readBlock(const TextureRef& t, int level) {
+    Block b{std::max(1, t.width >> level), std::max(1, t.height >> level), std::max(1, t.depth >> level), {}};
+    b.v.resize(size_t(b.w) * b.h * b.d * 4);
+    glGetTextureImage(t.id, level, GL_RGBA, GL_FLOAT, GLsizei(b.v.size() * sizeof(float)), b.v.data());
+    return b;
+}
+
+// The fixed cone set of shaders/common/fixed_cones.glsl, tile order: +pair j is tile
+// 2j, −pair j tile 2j+1. Written here from the icosahedron's vertices (0, ±1, ±φ) and
+// their cyclic permutations; the test below checks it is one.
+std::vector<glm::vec3> fixedConeDirections() {
+    const float phi = (1.0f + std::sqrt(5.0f)) / 2.0f;
+    const glm::vec3 pairs[6] = {{0, 1, phi}, {0, 1, -phi}, {1, phi, 0}, {-1, phi, 0}, {phi, 0, 1}, {phi, 0, -1}};
+    std::vector<glm::vec3> dirs;
+    for (const glm::vec3& p : pairs) {
+        dirs.push_back(glm::normalize(p));
+        dirs.push_back(-glm::normalize(p));
+    }
+    return dirs;
+}
+
 // World position of a pixel from the G-buffer depth and the rig's camera.
 glm::vec3 worldOf(Rig& rig, const FloatImage& depth, int x, int y) {
     const glm::mat4 inv = glm::inverse(rig.app.camera().projection(1.0f) * rig.app.camera().view());
@@ -398,6 +425,118 @@ TEST_CASE("voxel_mip: anisotropic levels composite front to back along their dir
     CHECK(d[3] == Approx(1.0f).margin(2e-3));
 }
 
+TEST_CASE("voxel_mip fixed_cones: each direction's chain is the d²-weighted blend of the three chains facing it",
+          "[gi][mip]") {
+    // The 12 directions are an icosahedron: unit, and each has 5 neighbours at
+    // arccos(1/√5) = 63.43°.
+    const std::vector<glm::vec3> dirs = fixedConeDirections();
+    for (const glm::vec3& a : dirs) {
+        int neighbours = 0;
+        for (const glm::vec3& b : dirs) neighbours += std::abs(glm::dot(a, b) - 1.0f / std::sqrt(5.0f)) < 1e-5f;
+        CHECK(neighbours == 5);
+    }
+    // The "layers" volume (16³): by hand (see the anisotropic test above), directional
+    // level 1 is +x (0.5, 0.5, 0, 1), −x (0, 1, 0, 1), ±y and ±z (0.375, 0.5, 0, 0.875).
+    // Every level of every tile is also checked against the aniso chains read back and
+    // blended here. Tolerance 2e-3: half floats (see above).
+    Rig rig(writeScene("empty_box.json", kEmptyBox), 32);
+    rig.load(pipeline("voxel_view.color", R"(
+        {"id": "volume", "module": "gi_volume", "params": {"pattern": "layers", "resolution": 16}},
+        {"id": "voxel_mip", "module": "voxel_mip", "inputs": {"radiance": "volume.radiance"},
+         "params": {"mode": "fixed_cones"}},
+        {"id": "voxel_view", "module": "voxel_view", "inputs": {"voxels": "voxel_mip.iso"}})"),
+             {"voxel_mip.aniso", "voxel_mip.fixed_cones"});
+    rig.app.frame();
+    rig.checkNoErrors();
+    const TextureRef& fixed = rig.tex("voxel_mip", "fixed_cones");
+    const TextureRef& aniso = rig.tex("voxel_mip", "aniso");
+    REQUIRE(fixed.width == 12 * 8);
+    REQUIRE(fixed.height == 8);
+    REQUIRE(fixed.depth == 8);
+    {
+        const glm::vec4 plusX(0.5f, 0.5f, 0, 1), minusX(0, 1, 0, 1), across(0.375f, 0.5f, 0, 0.875f);
+        Block level0 = readBlock(fixed, 0);
+        for (int t = 0; t < 12; ++t) {
+            const glm::vec3 d = dirs[size_t(t)];
+            const glm::vec4 expect = d.x * d.x * (d.x < 0 ? minusX : plusX) + (d.y * d.y + d.z * d.z) * across;
+            INFO("tile " << t);
+            const float* c = level0.at(t * 8 + 3, 5, 2);
+            for (int k = 0; k < 4; ++k) CHECK(c[k] == Approx(expect[k]).margin(2e-3));
+        }
+    }
+    double worst = 0;
+    int levels = 0;
+    for (int level = 0; (8 >> level) >= 1; ++level, ++levels) {
+        const int side = 8 >> level;
+        Block f = readBlock(fixed, level), a = readBlock(aniso, level);
+        for (int t = 0; t < 12; ++t) {
+            const glm::vec3 d = dirs[size_t(t)];
+            // Face i ∈ {+x,−x,+y,−y,+z,−z} in octant (i&1, (i>>1)&1, i>>2).
+            const int faces[3] = {d.x < 0 ? 1 : 0, d.y < 0 ? 3 : 2, d.z < 0 ? 5 : 4};
+            const float w[3] = {d.x * d.x, d.y * d.y, d.z * d.z};
+            for (int z = 0; z < side; ++z)
+                for (int y = 0; y < side; ++y)
+                    for (int x = 0; x < side; ++x)
+                        for (int k = 0; k < 4; ++k) {
+                            double blend = 0;
+                            for (int axis = 0; axis < 3; ++axis) {
+                                const int i = faces[axis];
+                                blend += w[axis] * a.at(x + (i & 1) * side, y + ((i >> 1) & 1) * side, z + (i >> 2) * side)[k];
+                            }
+                            worst = std::max(worst, std::abs(f.at(t * side + x, y, z)[k] - blend));
+                        }
+        }
+    }
+    CHECK(levels == 4);
+    CHECK(worst < 2e-3);
+}
+
+TEST_CASE("voxel_mip: a chain its mode does not fill cannot be bound, and cone_trace refuses settings it cannot honour",
+          "[gi][mip][errors]") {
+    auto gi = [](const std::string& mode, const std::string& chains, const std::string& params) {
+        return pipeline("cone_trace.indirect", R"(
+        {"id": "gbuffer", "module": "gbuffer"},
+        {"id": "volume", "module": "gi_volume", "params": {"pattern": "emissive_wall", "resolution": 16}},
+        {"id": "voxel_mip", "module": "voxel_mip", "inputs": {"radiance": "volume.radiance"},
+         "params": {"mode": ")" + mode + R"("}},
+        {"id": "cone_trace", "module": "cone_trace",
+         "inputs": {"normal": "gbuffer.normal", "depth": "gbuffer.depth", "voxels": "voxel_mip.iso")" + chains + R"(},
+         "params": {)" + params + "}}");
+    };
+    const std::string fixed = R"(, "fixed_cones": "voxel_mip.fixed_cones")";
+    Rig rig(writeScene("empty_box.json", kEmptyBox), 32);
+    std::string errors;
+    // In the file: a pipeline error at the binding, naming the mode that fills it.
+    CHECK_FALSE(rig.app.runtime().loadPipelineText(gi("aniso", fixed, ""), "test.json", errors));
+    CHECK_THAT(errors, Catch::Contains("passes[3].inputs.fixed_cones: \"voxel_mip.fixed_cones\" is filled only when "
+                                       "\"voxel_mip\"'s mode is \"fixed_cones\"; it is \"aniso\" "
+                                       "(passes[2].params.mode)"));
+    CHECK_FALSE(rig.app.runtime().loadPipelineText(gi("iso", R"(, "aniso": "voxel_mip.aniso")", ""), "test.json", errors));
+    CHECK_THAT(errors, Catch::Contains("is filled only when \"voxel_mip\"'s mode is \"aniso\" or \"fixed_cones\""));
+    // From the UI: the edit is refused and the running pipeline keeps its mode.
+    rig.load(gi("fixed_cones", fixed, ""), {"cone_trace.indirect"});
+    rig.app.frame();
+    rig.checkNoErrors();
+    std::string error;
+    CHECK_FALSE(rig.app.runtime().setParam("voxel_mip", "mode", std::string("iso"), error));
+    CHECK_THAT(error, Catch::Contains("is filled only when"));
+    const std::string* mode = rig.app.runtime().plan()->passes[size_t(rig.app.runtime().plan()->find("voxel_mip"))]
+                                  .params.get<std::string>("mode");
+    REQUIRE(mode);
+    CHECK(*mode == "fixed_cones");
+    // cone_trace: the fixed set has 6 cones; and one way of tracing at a time.
+    CHECK(rig.app.runtime().setParam("cone_trace", "cones", 9, error));
+    rig.app.frame();
+    auto active = rig.app.runtime().activeErrors();
+    REQUIRE(active.size() == 1);
+    CHECK_THAT(active[0], Catch::Contains("cones 9: the fixed set traces 6 cones a pixel"));
+    rig.load(gi("fixed_cones", fixed + R"(, "aniso": "voxel_mip.aniso")", ""), {"cone_trace.indirect"});
+    rig.app.frame();
+    active = rig.app.runtime().activeErrors();
+    REQUIRE(active.size() == 1);
+    CHECK_THAT(active[0], Catch::Contains("bind `aniso` or `fixed_cones`, not both"));
+}
+
 namespace {
 // Mean of `image` over G-buffer pixels whose normal and world position pass `keep`.
 double meanWhere(Rig& rig, const FloatImage& image, const FloatImage& normal, const FloatImage& depth,
@@ -426,15 +565,18 @@ TEST_CASE("cone_trace: a box lit by one emissive wall lights the opposite wall m
     // opposite one, its far half gets half as much. So the test compares the right
     // wall with the far halves (x > 0) and asks for a margin of 1.3× (physics: 2×),
     // and that the near halves (x < 0) get more than the far halves.
+    // Both cone sets: around the normal (three fetches a step) and the fixed one.
+    const std::string mode = GENERATE(std::string("aniso"), std::string("fixed_cones"));
+    INFO("voxel_mip.mode " << mode);
     Rig rig(writeScene("empty_box.json", kEmptyBox), 96);
     rig.load(pipeline("cone_trace.indirect", R"(
         {"id": "gbuffer", "module": "gbuffer"},
         {"id": "volume", "module": "gi_volume", "params": {"pattern": "emissive_wall", "resolution": 32}},
         {"id": "voxel_mip", "module": "voxel_mip", "inputs": {"radiance": "volume.radiance"},
-         "params": {"mode": "aniso"}},
+         "params": {"mode": ")" + mode + R"("}},
         {"id": "cone_trace", "module": "cone_trace",
          "inputs": {"normal": "gbuffer.normal", "depth": "gbuffer.depth", "voxels": "voxel_mip.iso",
-                    "aniso": "voxel_mip.aniso"}})"),
+                    ")" + mode + R"(": "voxel_mip.)" + mode + R"("}})"),
              {"gbuffer.normal", "gbuffer.depth"});
     rig.app.frame();
     rig.checkNoErrors();

@@ -17,7 +17,7 @@ TEST_CASE("kiln-bench-quality: a tiny sweep writes one finite CSV row per settin
           "[integration][bench]") {
     const std::string out = std::string(TEST_OUTPUT_DIR) + "/bench-quality";
     std::filesystem::remove_all(out);
-    const std::string args = "--size 32x32 --spp 8 --frames 1 --repeats 2 --time 0.1 --sweep cone_trace.cones=1,9 "
+    const std::string args = "--size 32x32 --spp 8 --frames 1 --repeats 2 --time 0.1 --sweep composite.pcf=1,9 "
                              "--also pipelines/seed.json --out " + out;
     Run first = runProgram(KILN_BENCH_QUALITY, args, 300);
     INFO(first.out << first.err);

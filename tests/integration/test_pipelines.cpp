@@ -21,13 +21,14 @@ TEST_CASE("every shipped pipeline compiles against the real modules, without war
     REQUIRE(options.availableModules.size() >= 8);  // the shipped passes were built
 
     int compiled = 0;
-    for (const auto& entry : fs::directory_iterator(fs::path(KILN_SOURCE_DIR) / "pipelines")) {
+    for (const char* dir : {"pipelines", "bench/pipelines"})
+    for (const auto& entry : fs::directory_iterator(fs::path(KILN_SOURCE_DIR) / dir)) {
         const fs::path p = entry.path();
         if (p.extension() != ".json" || p.filename() == "pipeline.schema.json") continue;
         std::ifstream in(p);
         std::stringstream text;
         text << in.rdbuf();
-        auto plan = graph::compileText(text.str(), "pipelines/" + p.filename().string(), options);
+        auto plan = graph::compileText(text.str(), std::string(dir) + "/" + p.filename().string(), options);
         INFO(p.filename().string() << ":\n" << plan.errorText());
         REQUIRE(plan.ok());
         CHECK(plan->warnings.empty());
@@ -35,6 +36,6 @@ TEST_CASE("every shipped pipeline compiles against the real modules, without war
         CHECK_FALSE(plan->runOrder().empty());
         ++compiled;
     }
-    // default, iso_mips, direct_only, voxels at least.
-    CHECK(compiled >= 4);
+    // default, iso_mips, direct_only, voxels, and the two benchmark pipelines at least.
+    CHECK(compiled >= 6);
 }
