@@ -13,11 +13,11 @@
 // seed's "bright part of the G-buffer colour"); direct-lit surfaces stay around 1 and
 // would not pass a threshold of 1 anyway. No lighting/composite split is needed.
 //
-// Nothing bright: the bright-pass also reduces the brightest input luminance (one
-// atomicMax per 8×8 group) into a 4-byte buffer that the blur reads; below the
-// threshold every blur fragment writes black without a single tap. The value never
-// comes back to the CPU: a read-back right after the dispatch would stall the CPU on
-// the GPU every frame.
+// Nothing bright: the bright-pass also raises a flag in a 4-byte buffer (an atomicOr
+// from each block with a texel above the threshold) that the blur reads; with the flag
+// down every blur fragment writes black without a single tap. The flag never comes
+// back to the CPU: a read-back right after the dispatch would stall the CPU on the GPU
+// every frame.
 #include <kiln/pass.hpp>
 
 #include <algorithm>
@@ -29,7 +29,7 @@ namespace {
 class Bloom final : public kiln::Pass {
 public:
     ~Bloom() override {
-        if (maxBuffer_) glDeleteBuffers(1, &maxBuffer_);
+        if (anyBright_) glDeleteBuffers(1, &anyBright_);
     }
 
     kiln::PassDeclaration declare() const override {
@@ -56,18 +56,18 @@ public:
         const kiln::TextureRef& bright = ctx.internal("bright");
         const float threshold = ctx.getFloat("threshold");
 
-        // 1. Bright-pass + downsample, and the brightest luminance for the blur's early out.
-        if (!maxBuffer_) {
-            glCreateBuffers(1, &maxBuffer_);
-            glNamedBufferStorage(maxBuffer_, 4, nullptr, GL_DYNAMIC_STORAGE_BIT);
+        // 1. Bright-pass + downsample, and the "anything bright" flag for the blur's early out.
+        if (!anyBright_) {
+            glCreateBuffers(1, &anyBright_);
+            glNamedBufferStorage(anyBright_, 4, nullptr, GL_DYNAMIC_STORAGE_BIT);
         }
         const GLuint zero = 0;
-        glNamedBufferSubData(maxBuffer_, 0, 4, &zero);
+        glNamedBufferSubData(anyBright_, 0, 4, &zero);
         glUseProgram(brightPass);
         glUniform1f(glGetUniformLocation(brightPass, "u_threshold"), threshold);
         glBindTextureUnit(0, in.id);
         glBindImageTexture(0, bright.id, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA16F);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, maxBuffer_);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, anyBright_);
         glDispatchCompute(GLuint((bright.width + 7) / 8), GLuint((bright.height + 7) / 8), 1);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
 
@@ -75,7 +75,6 @@ public:
         glUseProgram(blur);
         glUniform1i(glGetUniformLocation(blur, "u_radius"), (ctx.getInt("radius") + 1) / 2);
         glUniform1f(glGetUniformLocation(blur, "u_sigma"), std::max(0.5f, float(ctx.getInt("radius")) * 0.25f));
-        glUniform1f(glGetUniformLocation(blur, "u_threshold"), threshold);
         if (!ctx.framebuffer({"ping"})) return;
         glUniform2f(glGetUniformLocation(blur, "u_direction"), 1.0f, 0.0f);
         glUniform1f(glGetUniformLocation(blur, "u_gain"), 1.0f);
@@ -89,7 +88,7 @@ public:
     }
 
 private:
-    GLuint maxBuffer_ = 0;  // 4 bytes: the brightest luminance (float bits), GPU only
+    GLuint anyBright_ = 0;  // 4 bytes: nonzero when a texel passed the threshold, GPU only
 };
 
 }  // namespace

@@ -5,15 +5,14 @@ layout(binding = 0) uniform sampler2D u_src;
 uniform vec2 u_direction;
 uniform int u_radius;
 uniform float u_sigma;
-uniform float u_threshold;
 uniform float u_gain;
-// The input's brightest luminance (bloom/bright.comp): nothing above the threshold ⇒ black.
-layout(std430, binding = 1) readonly buffer MaxLum { uint u_maxBits; };
+// Set by bloom/bright.comp when some input texel is above the threshold; else black.
+layout(std430, binding = 1) readonly buffer AnyBright { uint u_anyBright; };
 
 layout(location = 0) out vec4 o_color;
 
 void main() {
-    if (!(uintBitsToFloat(u_maxBits) > u_threshold)) {
+    if (u_anyBright == 0u) {
         o_color = vec4(0.0, 0.0, 0.0, 1.0);
         return;
     }

@@ -2,15 +2,16 @@
 // Bright-pass and 2× downsample in one: each invocation averages one 2×2 block of the
 // full-resolution input, each texel first reduced to its part above the threshold
 // (colour scaled by (lum − threshold) / lum), and stores the half-resolution texel.
-// The group also reduces the brightest input luminance into one atomicMax, which the
-// blur reads to write black without a tap when nothing passes. Non-negative floats
-// order like their bit patterns, so the maximum is kept as uint bits.
+// An invocation whose block has a texel above the threshold also raises a flag, which
+// the blur reads to write black without a tap when nothing passes. No reduction in
+// shared memory: on llvmpipe every barrier() suspends and resumes each invocation, and
+// the seven of a 64-wide tree cost more than the whole bright-pass (measured); an
+// atomicOr from the few bright blocks costs nothing.
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(binding = 0) uniform sampler2D u_color;
 layout(binding = 0, rgba16f) uniform writeonly image2D u_bright;
-layout(std430, binding = 1) buffer MaxLum { uint u_maxBits; };
+layout(std430, binding = 1) buffer AnyBright { uint u_anyBright; };
 uniform float u_threshold;
-shared float s_max[64];
 
 void main() {
     ivec2 size = textureSize(u_color, 0);
@@ -24,11 +25,5 @@ void main() {
         sum += l > u_threshold ? c * ((l - u_threshold) / l) : vec3(0.0);
     }
     if (all(lessThan(q, imageSize(u_bright)))) imageStore(u_bright, q, vec4(0.25 * sum, 1.0));
-    s_max[gl_LocalInvocationIndex] = m;
-    barrier();
-    for (uint s = 32u; s > 0u; s >>= 1) {
-        if (gl_LocalInvocationIndex < s) s_max[gl_LocalInvocationIndex] = max(s_max[gl_LocalInvocationIndex], s_max[gl_LocalInvocationIndex + s]);
-        barrier();
-    }
-    if (gl_LocalInvocationIndex == 0u) atomicMax(u_maxBits, floatBitsToUint(min(s_max[0], 65504.0)));
+    if (m > u_threshold) atomicOr(u_anyBright, 1u);
 }
