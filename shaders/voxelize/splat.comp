@@ -1,33 +1,60 @@
 #version 450 core
-// Voxelization of the particles without their meshes: one invocation per particle adds
-// its emitted radiance, as one fragment would, to every voxel its bounding box
-// overlaps (one voxel for a particle smaller than a voxel, at most 2×2×2), into the
-// same fixed-point sums and count as voxelize.frag, so resolve.comp averages it with
-// the surfaces around it. The particles are the instances [u_first, u_first +
-// u_particleCount) of the scene's instance buffer; they are emitters with no albedo,
-// so no lamp light and no shadow test. Cost: a few atomics per particle, where
-// rasterizing the mesh cost a geometry shader invocation per triangle.
+// Voxelization of spheres without their meshes: one invocation per sphere adds one
+// fragment's radiance to every voxel the sphere's surface passes through (the voxel's
+// nearest point within the radius of the centre, its farthest corner beyond it), into
+// the same fixed-point sums and count as voxelize.frag, so resolve.comp averages it with
+// the surfaces around it. A sphere smaller than a voxel lands in the voxels its bounding
+// box overlaps (at most 2×2×2).
+//   fireballs  emission plus the lamp's light on the surface point facing the voxel's
+//              centre, with the hard shadow test voxelize.frag makes: the first
+//              u_litCount spheres.
+//   particles  emitters with no albedo: their emission; the rest.
+// The spheres are the instances [u_first, u_first + u_sphereCount) of the scene's
+// instance buffer. Cost: a few atomics per voxel of the shell, where rasterizing the mesh cost a
+// geometry-shader invocation per triangle.
+#include "common/frame.glsl"
 #include "common/instances.glsl"
+#include "common/light.glsl"
 #include "sums.glsl"
 
 layout(local_size_x = 64) in;
 
+layout(binding = 0) uniform sampler2D u_shadowMap;
+
 uniform uint u_first;
-uniform uint u_particleCount;
+uniform uint u_sphereCount;
 uniform int u_res;
+uniform uint u_litCount;
+uniform float u_shadowBias;
 
 void main() {
-    if (gl_GlobalInvocationID.x >= u_particleCount) return;
+    if (gl_GlobalInvocationID.x >= u_sphereCount) return;
     KilnInstance inst = kiln_instances[u_first + gl_GlobalInvocationID.x];
     vec3 centre = kilnSphereCentre(inst);
     float radius = kilnSphereRadius(inst);
-    uvec3 fixedRgb = toFixedRadiance(inst.emissive.rgb);
-    // Voxel index range of the bounding box, at most two voxels per axis.
-    ivec3 lo = ivec3(floor(((centre - radius) * 0.5 + 0.5) * float(u_res)));
-    ivec3 hi = min(ivec3(floor(((centre + radius) * 0.5 + 0.5) * float(u_res))), lo + 1);
-    lo = max(lo, ivec3(0));
-    hi = min(hi, ivec3(u_res - 1));
+    float voxel = 2.0 / float(u_res);
+    ivec3 lo = max(ivec3(floor(((centre - radius) * 0.5 + 0.5) * float(u_res))), ivec3(0));
+    ivec3 hi = min(ivec3(floor(((centre + radius) * 0.5 + 0.5) * float(u_res))), ivec3(u_res - 1));
+    uvec3 emitted = toFixedRadiance(inst.emissive.rgb);
     for (int z = lo.z; z <= hi.z; ++z)
         for (int y = lo.y; y <= hi.y; ++y)
-            for (int x = lo.x; x <= hi.x; ++x) addToVoxel(ivec3(x, y, z), fixedRgb);
+            for (int x = lo.x; x <= hi.x; ++x) {
+                vec3 cubeLo = vec3(x, y, z) * voxel - 1.0;
+                vec3 cubeHi = cubeLo + voxel;
+                float nearest = distance(clamp(centre, cubeLo, cubeHi), centre);
+                float farthest = length(max(abs(cubeLo - centre), abs(cubeHi - centre)));
+                if (nearest > radius || farthest < radius) continue;
+                uvec3 fixedRgb = emitted;
+                if (gl_GlobalInvocationID.x < u_litCount) {
+                    vec3 towards = 0.5 * (cubeLo + cubeHi) - centre;
+                    vec3 n = dot(towards, towards) > 1e-12 ? normalize(towards) : vec3(0.0, 1.0, 0.0);
+                    vec3 p = centre + n * radius;
+                    float vis = 1.0;
+#if KILN_HAS_SHADOW_MAP
+                    vis = shadowHard(u_shadowMap, p + n * voxel, u_shadowBias);
+#endif
+                    fixedRgb = toFixedRadiance(inst.albedo.rgb / 3.14159265 * lampLight(p, n) * vis + inst.emissive.rgb);
+                }
+                addToVoxel(ivec3(x, y, z), fixedRgb);
+            }
 }

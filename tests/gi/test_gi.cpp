@@ -258,6 +258,80 @@ TEST_CASE("voxelize: splatted particles land where the simulation has them and g
     CHECK(occupied[1] == Approx(occupied[0]).epsilon(0.03));
 }
 
+TEST_CASE("voxelize: splatted fireballs fill the voxels their surfaces pass through, lit like their meshes",
+          "[gi][voxelize]") {
+    // The shipped scene 1 s in, its particles splatted (one dispatch with the fireballs),
+    // voxelized with fireball_mode mesh (the sphere rasterized) and splat, at 32³ (a fireball about two voxels wide) and
+    // 64³ (four). Against the simulation: every voxel holding a point of a fireball's
+    // surface (26 directions) is occupied in both. Against each other: the light and
+    // the occupied voxels of the whole volume, and the light within a voxel of each
+    // fireball.
+    for (int res : {32, 64}) {
+        Volume vol[2];
+        std::vector<std::pair<glm::vec3, float>> fireballs;
+        for (int mode = 0; mode < 2; ++mode) {
+            Rig rig("", 64);
+            while (rig.app.scene().time() < 1.0) rig.app.scene().step();
+            rig.load(pipeline("voxel_view.color", R"(
+                {"id": "shadow", "module": "shadow", "params": {"size": 256}},
+                {"id": "voxelize", "module": "voxelize", "inputs": {"shadow_map": "shadow.depth"},
+                 "params": {"resolution": )" + std::to_string(res) + R"(, "fireball_mode": ")" +
+                                                      (mode ? "splat" : "mesh") + R"("}},
+                {"id": "voxel_view", "module": "voxel_view", "inputs": {"voxels": "voxelize.radiance"}})"));
+            rig.app.frame();
+            rig.checkNoErrors();
+            vol[mode] = read3d(rig.tex("voxelize", "radiance"), 0);
+            fireballs.clear();
+            for (auto& b : rig.app.scene().sim().balls())
+                if (b.kind == sim::BallKind::Fireball)
+                    fireballs.emplace_back(glm::vec3(float(b.position.x), float(b.position.y), float(b.position.z)),
+                                           float(b.radius));
+        }
+        REQUIRE(fireballs.size() == 2);
+        auto voxelOf = [&](glm::vec3 p) { return glm::clamp(glm::ivec3(glm::floor((p * 0.5f + 0.5f) * float(res))), 0, res - 1); };
+        for (int mode = 0; mode < 2; ++mode) {
+            int missing = 0;
+            for (auto& [c, r] : fireballs)
+                for (int dz = -1; dz <= 1; ++dz)
+                    for (int dy = -1; dy <= 1; ++dy)
+                        for (int dx = -1; dx <= 1; ++dx) {
+                            if (!dx && !dy && !dz) continue;
+                            const glm::ivec3 v = voxelOf(c + r * glm::normalize(glm::vec3(dx, dy, dz)));
+                            missing += vol[mode].at(v.x, v.y, v.z)[3] < 0.5f;
+                        }
+            INFO(res << "³ " << (mode ? "splat" : "mesh") << ": " << missing << " of " << 26 * fireballs.size()
+                     << " surface voxels empty");
+            CHECK(missing == 0);
+        }
+        double light[2] = {0, 0}, occupied[2] = {0, 0}, near[2] = {0, 0};
+        for (int mode = 0; mode < 2; ++mode) {
+            for (size_t i = 0; i < vol[mode].v.size(); i += 4) {
+                light[mode] += vol[mode].v[i] + vol[mode].v[i + 1] + vol[mode].v[i + 2];
+                occupied[mode] += vol[mode].v[i + 3];
+            }
+            for (auto& [c, r] : fireballs) {
+                const glm::ivec3 lo = voxelOf(c - glm::vec3(r + 2.0f / float(res))), hi = voxelOf(c + glm::vec3(r + 2.0f / float(res)));
+                for (int z = lo.z; z <= hi.z; ++z)
+                    for (int y = lo.y; y <= hi.y; ++y)
+                        for (int x = lo.x; x <= hi.x; ++x) near[mode] += vol[mode].at(x, y, z)[0];
+            }
+        }
+        WARN(res << "³: sum rgb mesh " << light[0] << " splat " << light[1] << "; occupied mesh " << occupied[0]
+                 << " splat " << occupied[1] << "; red near the fireballs mesh " << near[0] << " splat " << near[1]);
+        // Measured: Σ rgb 4 718 / 4 627 (32³) and 19 415 / 19 206 (64³); occupied 6 204 /
+        // 6 203 and 25 795 / 25 791. Near the fireballs the splat holds less red (82 % at
+        // 32³, 89 % at 64³): it adds one fragment per voxel where the rasterized mesh's
+        // conservative triangles add several, so where a fireball shares a voxel with its
+        // particles or a wall it weighs less. Bounds: 5 % and 1 % for the whole volume; 70–
+        // 105 % near the fireballs, which still fails a splat that drops the fireballs
+        // (measured: 61 % and 47 %, their particles stay) or adds them twice.
+        CHECK(light[1] == Approx(light[0]).epsilon(0.05));
+        CHECK(occupied[1] == Approx(occupied[0]).epsilon(0.01));
+        CHECK(near[1] > 0.70 * near[0]);
+        CHECK(near[1] < 1.05 * near[0]);
+    }
+}
+
 TEST_CASE("gbuffer: particles drawn as points cover what their meshes cover, where the simulation has them",
           "[gi][gbuffer]") {
     // The shipped scene 1 s in, the G-buffer at 256² with particle_mode points and mesh.
