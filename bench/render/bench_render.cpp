@@ -218,6 +218,12 @@ bool measureRound(const Args& args, const Config& config, const std::string& tex
         glFinish();
         walls.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
     }
+    // A pass that failed (a shader that does not compile, a module's ctx.fail) did not
+    // do its work: its configuration has no honest time.
+    if (auto errors = app.runtime().activeErrors(); !errors.empty()) {
+        error = config.label + ": " + errors.front();
+        return false;
+    }
     app.runtime().collectGpuTimes();
     m.frameMs.push_back(median(walls));
     m.particles.push_back(double(app.scene().sim().particles().size()));

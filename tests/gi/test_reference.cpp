@@ -171,7 +171,7 @@ TEST_CASE("reference vs rasterizer: the lamp's direct light on a floor agrees (o
     CHECK(rel < 0.05);
 }
 
-TEST_CASE("error pass: an image against itself is black; a darker one reads blue in signed mode",
+TEST_CASE("error pass: an image against itself is black, a darker one reads blue in signed mode",
           "[gi][reference]") {
     Rig rig(stillScene(), 16);
     auto run = [&](const std::string& image, const std::string& mode) {

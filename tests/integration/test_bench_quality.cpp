@@ -66,7 +66,7 @@ TEST_CASE("kiln-bench-quality: a pipeline or scene file it cannot read is a usag
     }
 }
 
-TEST_CASE("kiln-bench-render --grow: one growth row per count, the first the baseline; bad arguments are named",
+TEST_CASE("kiln-bench-render --grow: one growth row per count, the first the baseline, bad arguments and failing passes are errors",
           "[integration][bench]") {
     const std::string out = std::string(TEST_OUTPUT_DIR) + "/bench-grow";
     std::filesystem::remove_all(out);
@@ -108,6 +108,13 @@ TEST_CASE("kiln-bench-render --grow: one growth row per count, the first the bas
     Run missing = runProgram(KILN_BENCH_RENDER, "--scene no/such.json --grow fireballs=1 --out " + out, 60);
     CHECK(missing.exitCode == 2);
     CHECK(missing.err.find("no/such.json: cannot read the scene file") != std::string::npos);
+    // A configuration whose pass fails did not do its work: an error, not a time.
+    Run failing = runProgram(KILN_BENCH_RENDER,
+                             "--size 32x32 --frames 1 --repeats 1 --settle 0.1 --set cone_trace.cones=9 --out " + out, 120);
+    INFO(failing.out << failing.err);
+    CHECK(failing.exitCode == 1);
+    CHECK(failing.err.find("cones 9: the fixed set traces 6 cones a pixel") != std::string::npos);
+    CHECK(failing.out.find("frame (wall, glFinish)") == std::string::npos);
 }
 
 TEST_CASE("the default pipeline is closer to the path-traced reference than the seed's design (seed.json)",
