@@ -79,6 +79,17 @@ inline std::map<std::string, PassDeclaration> fakeModules() {
     m["divided_volume"]
         .output({"color", TextureKind::Color3D, Format::RGBA8, SizeRule::relativeOverParam("stride"), 1, ""})
         .param(intParam("stride", 2, 1, 4));
+    // Outputs filled only for some values: one naming a value the enum does not have,
+    // one naming a parameter that is not an enum, and a tiled strip with 0 tiles.
+    m["produced_when_wrong"]
+        .output({"color", TextureKind::Color2D, Format::RGBA8, SizeRule::relative(), 1, "", 0.0f, 0.0f,
+                 ProducedWhen{"mode", {"fast", "slwo"}}})
+        .output({"other", TextureKind::Color2D, Format::RGBA8, SizeRule::relative(), 1, "", 0.0f, 0.0f,
+                 ProducedWhen{"scale", {"1"}}})
+        .output({"strip", TextureKind::Color3D, Format::RGBA8, SizeRule::fromInput("volume", 1.0f, 0), 1, ""})
+        .input({"volume", TextureKind::Color3D, false, Fallback::Black, ""})
+        .param(enumParam("mode", "fast", {"fast", "slow"}))
+        .param(floatParam("scale", 1.0f, 0.0, 2.0));
     return m;
 }
 

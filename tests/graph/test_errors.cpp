@@ -250,6 +250,10 @@ TEST_CASE("output size from a bad parameter is reported against the module", "[e
                            "parameter \"stride\", which is a float, not an int"));
     e = errorsOf(R"({ "output": "b.color", "passes": [ { "id": "b", "module": "divided_volume" } ] })");
     CHECK_THAT(e, Contains("module \"divided_volume\" declares output \"color\" is 3D but sized relative to the (2D) output"));
+    e = errorsOf(R"({ "output": "b.color", "passes": [ { "id": "b", "module": "produced_when_wrong" } ] })");
+    CHECK_THAT(e, Contains("declares output \"color\" is produced when \"mode\" is \"slwo\", which is not one of its choices"));
+    CHECK_THAT(e, Contains("declares output \"other\" is produced when \"scale\" has some values, but it is not an enum"));
+    CHECK_THAT(e, Contains("declares output \"strip\" has 0 tiles (must be >= 1)"));
 }
 
 TEST_CASE("all errors are collected, in file order", "[errors]") {
