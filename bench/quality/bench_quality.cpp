@@ -4,12 +4,13 @@
 //
 //   kiln-bench-quality [--pipeline FILE] [--also FILE]... [--scene FILE] [--time SECONDS]
 //                      [--size WxH] [--spp N] [--frames N] [--repeats R]
-//                      [--sweep PASS.PARAM=V1,V2,...]... [--cartesian] [--out DIR]
+//                      [--sweep PASS.PARAM=V1,V2,...]... [--cartesian] [--out DIR] [--cache DIR]
 //
 // 1. Steps the scene to --time and freezes it.
 // 2. The reference (passes/reference) at --spp paths per pixel, cached as OpenEXR in
-//    DIR/cache/ under a hash of the scene file, time, size and sample count (progress
-//    and ETA on stderr while it renders).
+//    --cache (default: DIR/cache/) under a hash of the scene file, the simulation's
+//    state at --time, the size, the sample count and the reference pass's code
+//    (progress and ETA on stderr while it renders).
 // 3. The pipeline once as it is ("default"), each --also pipeline as it is (labelled by
 //    its file name, e.g. pipelines/seed.json: before and after in one run), and once
 //    per value of each --sweep (one
@@ -74,6 +75,7 @@ struct Args {
     std::vector<std::string> also;  // more pipelines, measured as they are
     bool cartesian = false;  // every combination of the sweeps, not one knob at a time
     std::string outDir = "bench-out";
+    std::string cacheDir;  // empty: outDir/cache
 };
 
 [[noreturn]] void usageError(const std::string& message) {
@@ -121,10 +123,11 @@ Args parseArgs(int argc, char** argv) {
         else if (a == "--cartesian") args.cartesian = true;
         else if (a == "--sweep") args.sweeps.push_back(next());
         else if (a == "--out") args.outDir = next();
+        else if (a == "--cache") args.cacheDir = next();
         else if (a == "--help" || a == "-h") {
             std::printf("usage: kiln-bench-quality [--pipeline FILE] [--also FILE]... [--scene FILE] [--time S] [--size WxH] [--spp N]\n"
                         "                          [--frames N] [--repeats R] [--sweep PASS.PARAM=V1,V2,...]... [--cartesian]\n"
-                        "                          [--out DIR]\n");
+                        "                          [--out DIR] [--cache DIR]\n");
             std::exit(0);
         } else usageError("unknown argument \"" + a + "\"");
     }
@@ -180,14 +183,26 @@ bool fail(const std::string& message) {
 }
 
 // The reference radiance, from the cache or rendered now.
+// The cache key covers everything the reference image depends on: the scene file (looks,
+// lamp), the simulation's state at --time (so a change to the simulation's code is a new
+// reference), the size and sample count, and the reference pass's code: its shaders,
+// the shared ones it includes and its module's source.
 bool reference(app::App& app, const Args& args, FloatImage& out, FloatImage& direct) {
     const std::string sceneText = slurp(args.scene);
     uint64_t key = fnv1a(sceneText);
     const double values[] = {args.time, double(args.width), double(args.height), double(args.spp)};
     key = fnv1a(values, sizeof values, key);
+    const uint64_t simState = app.scene().sim().stateHash();
+    key = fnv1a(&simState, sizeof simState, key);
+    const fs::path source(KILN_SOURCE_DIR);
+    std::vector<fs::path> code = {source / "passes/reference/reference.cpp"};
+    for (const char* dir : {"shaders/reference", "shaders/common"})
+        for (const auto& entry : fs::directory_iterator(source / dir)) code.push_back(entry.path());
+    std::sort(code.begin(), code.end());
+    for (const fs::path& file : code) key = fnv1a(slurp(file.string()), key);
     char name[64];
     std::snprintf(name, sizeof name, "reference-%016llx.exr", static_cast<unsigned long long>(key));
-    const fs::path cache = fs::path(args.outDir) / "cache" / name;
+    const fs::path cache = (args.cacheDir.empty() ? fs::path(args.outDir) / "cache" : fs::path(args.cacheDir)) / name;
     fs::path directCache = cache;
     directCache.replace_extension(".direct.exr");
     std::string error;

@@ -53,6 +53,17 @@ TEST_CASE("kiln-bench-quality: a tiny sweep writes one finite CSV row per settin
     Run second = runProgram(KILN_BENCH_QUALITY, args, 300);
     CHECK(second.exitCode == 0);
     CHECK(second.out.find("(cached)") != std::string::npos);
+    // Another output folder shares the cache through --cache; another moment of the
+    // simulation is another reference.
+    const std::string shared = "--size 32x32 --spp 8 --frames 1 --repeats 1 --sweep composite.pcf=1 --cache " + out +
+                               "/cache --out " + out + "-b";
+    Run third = runProgram(KILN_BENCH_QUALITY, shared + " --time 0.1", 300);
+    CHECK(third.exitCode == 0);
+    CHECK(third.out.find("(cached)") != std::string::npos);
+    Run later = runProgram(KILN_BENCH_QUALITY, shared + " --time 0.2", 300);
+    CHECK(later.exitCode == 0);
+    CHECK(later.out.find("(cached)") == std::string::npos);
+    CHECK(later.out.find("cached as " + out + "/cache/") != std::string::npos);
 }
 
 TEST_CASE("kiln-bench-quality: a pipeline or scene file it cannot read is a usage error before the reference renders",
