@@ -181,11 +181,12 @@ public:
 
         if (!(upsampled ? ctx.framebuffer({"samples", "planes"}) : ctx.framebuffer({"indirect"}))) return;
         glUseProgram(trace);
-        const std::vector<float> cones = coneSet(ctx.getInt("cones"));
         auto loc = [&](const char* n) { return glGetUniformLocation(trace, n); };
-        glUniform1i(loc("u_coneCount"), GLint(cones.size() / 4));
-        glUniform4fv(loc("u_cones"), GLsizei(cones.size() / 4), cones.data());
-        glUniform1f(loc("u_tanHalf"), std::tan(ctx.getFloat("aperture") * 0.5f * float(M_PI) / 180.0f));
+        if (!ctx.isBound("fixed_cones")) {  // the fixed set is the shader's own
+            const std::vector<float> cones = coneSet(ctx.getInt("cones"));
+            glUniform1i(loc("u_coneCount"), GLint(cones.size() / 4));
+            glUniform4fv(loc("u_cones"), GLsizei(cones.size() / 4), cones.data());
+        }
         glUniform1f(loc("u_startOffset"), ctx.getFloat("start_offset"));
         glUniform1f(loc("u_diameterOffset"), ctx.getFloat("diameter_offset"));
         glUniform1f(loc("u_voxelRes"), float(voxels.width));

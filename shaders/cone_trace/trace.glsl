@@ -1,9 +1,6 @@
 // Diffuse cone tracing through the mipped voxels (shaders/cone_trace/voxels.glsl).
 #include "voxels.glsl"
 
-const int kMaxCones = 16;
-uniform int u_coneCount;
-uniform vec4 u_cones[kMaxCones];  // xyz = direction in the normal's frame (z = normal), w = weight (Σ = 1)
 uniform float u_startOffset;      // in level-0 voxels, along the normal
 uniform float u_diameterOffset;   // × each sample's diameter, along the normal
 
@@ -66,6 +63,11 @@ vec4 traceDiffuse(vec3 p, vec3 n) {
     return vec4(sum.rgb, 1.0 - sum.a);
 }
 #else
+// The cone set around the normal (passes/cone_trace/cone_trace.cpp coneSet).
+const int kMaxCones = 16;
+uniform int u_coneCount;
+uniform vec4 u_cones[kMaxCones];  // xyz = direction in the normal's frame (z = normal), w = weight (Σ = 1)
+
 vec4 traceDiffuse(vec3 p, vec3 n) {
     vec3 up = abs(n.y) < 0.95 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0);
     vec3 tx = normalize(cross(up, n));
