@@ -58,52 +58,55 @@ bool splitBinding(const std::string& text, std::string& pass, std::string& outpu
     return true;
 }
 
+// The parameter `name` of a declaration; null when it declares none.
+const ParamDecl* declaredParam(const PassDeclaration& d, const std::string& name) {
+    auto it = std::find_if(d.params.begin(), d.params.end(), [&](const ParamDecl& p) { return p.name == name; });
+    return it == d.params.end() ? nullptr : &*it;
+}
+
 // Problems in one output or internal texture declaration.
 void checkTexture(const char* what, const TextureDecl& t, const PassDeclaration& d, std::vector<std::string>& problems) {
     const std::string name = std::string(what) + " " + q(t.name);
     if ((t.kind == TextureKind::Depth2D) != isDepthFormat(t.format))
         problems.push_back(name + " is " + toString(t.kind) + " but has format " + toString(t.format));
+    auto checkScale = [&] {
+        if (!(t.size.scale > 0.0f)) problems.push_back(name + " has scale " + num(t.size.scale) + " (must be > 0)");
+    };
+    auto checkRelative = [&] {  // a multiple of the (2D) output size
+        if (t.kind == TextureKind::Color3D) problems.push_back(name + " is 3D but sized relative to the (2D) output");
+        checkScale();
+    };
     switch (t.size.mode) {
-        case SizeRule::Mode::RelativeToOutput:
-            if (t.kind == TextureKind::Color3D)
-                problems.push_back(name + " is 3D but sized relative to the (2D) output");
-            if (!(t.size.scale > 0.0f)) problems.push_back(name + " has scale " + num(t.size.scale) + " (must be > 0)");
-            break;
+        case SizeRule::Mode::RelativeToOutput: checkRelative(); break;
         case SizeRule::Mode::Fixed:
             if (t.size.width < 1 || t.size.height < 1 || (t.kind == TextureKind::Color3D && t.size.depth < 1))
                 problems.push_back(name + " has a fixed size with a side < 1");
             break;
-        case SizeRule::Mode::RelativeOverParam:
-            if (t.kind == TextureKind::Color3D)
-                problems.push_back(name + " is 3D but sized relative to the (2D) output");
-            if (!(t.size.scale > 0.0f)) problems.push_back(name + " has scale " + num(t.size.scale) + " (must be > 0)");
-            [[fallthrough]];
+        case SizeRule::Mode::RelativeOverParam: checkRelative(); [[fallthrough]];
         case SizeRule::Mode::FromParam: {
-            auto it = std::find_if(d.params.begin(), d.params.end(),
-                                   [&](const ParamDecl& p) { return p.name == t.size.source; });
-            if (it == d.params.end())
+            const ParamDecl* side = declaredParam(d, t.size.source);
+            if (!side)
                 problems.push_back(name + " takes its size from unknown parameter " + q(t.size.source));
-            else if (it->type != ParamType::Int)
+            else if (side->type != ParamType::Int)
                 problems.push_back(name + " takes its size from parameter " + q(t.size.source) + ", which is a " +
-                                   toString(it->type) + ", not an int");
+                                   toString(side->type) + ", not an int");
             break;
         }
         case SizeRule::Mode::FromInput:
             if (std::none_of(d.inputs.begin(), d.inputs.end(), [&](const InputDecl& in) { return in.name == t.size.source; }))
                 problems.push_back(name + " takes its size from unknown input " + q(t.size.source));
-            if (!(t.size.scale > 0.0f)) problems.push_back(name + " has scale " + num(t.size.scale) + " (must be > 0)");
+            checkScale();
             break;
     }
-    if (!t.producedWhen.param.empty()) {
-        auto it = std::find_if(d.params.begin(), d.params.end(),
-                               [&](const ParamDecl& p) { return p.name == t.producedWhen.param; });
-        if (it == d.params.end() || it->type != ParamType::Enum)
-            problems.push_back(name + " is produced when " + q(t.producedWhen.param) + " has some values, but " +
-                               (it == d.params.end() ? "there is no such parameter" : "it is not an enum"));
+    if (const std::string& param = t.producedWhen.param; !param.empty()) {
+        const ParamDecl* choice = declaredParam(d, param);
+        if (!choice || choice->type != ParamType::Enum)
+            problems.push_back(name + " is produced when " + q(param) + " has some values, but " +
+                               (!choice ? "there is no such parameter" : "it is not an enum"));
         else
             for (const std::string& v : t.producedWhen.values)
-                if (std::find(it->choices.begin(), it->choices.end(), v) == it->choices.end())
-                    problems.push_back(name + " is produced when " + q(t.producedWhen.param) + " is " + q(v) +
+                if (std::find(choice->choices.begin(), choice->choices.end(), v) == choice->choices.end())
+                    problems.push_back(name + " is produced when " + q(param) + " is " + q(v) +
                                        ", which is not one of its choices");
     }
     if (t.size.tiles < 1) problems.push_back(name + " has " + std::to_string(t.size.tiles) + " tiles (must be >= 1)");
