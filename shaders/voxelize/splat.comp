@@ -6,7 +6,7 @@
 // the surfaces around it. A sphere smaller than a voxel lands in the voxels its bounding
 // box overlaps (at most 2×2×2).
 //   fireballs  emission plus the lamp's light on the surface point facing the voxel's
-//              centre, with the hard shadow test voxelize.frag makes: the first
+//              centre, lit as voxelize.frag lights a fragment (surface.glsl): the first
 //              u_litCount spheres.
 //   particles  emitters with no albedo: their emission; the rest.
 // The spheres are the instances [u_first, u_first + u_sphereCount) of the scene's
@@ -16,16 +16,13 @@
 #include "common/instances.glsl"
 #include "common/light.glsl"
 #include "sums.glsl"
+#include "surface.glsl"
 
 layout(local_size_x = 64) in;
 
-layout(binding = 0) uniform sampler2D u_shadowMap;
-
 uniform uint u_first;
 uniform uint u_sphereCount;
-uniform int u_res;
 uniform uint u_litCount;
-uniform float u_shadowBias;
 
 void main() {
     if (gl_GlobalInvocationID.x >= u_sphereCount) return;
@@ -48,12 +45,7 @@ void main() {
                 if (gl_GlobalInvocationID.x < u_litCount) {
                     vec3 towards = 0.5 * (cubeLo + cubeHi) - centre;
                     vec3 n = dot(towards, towards) > 1e-12 ? normalize(towards) : vec3(0.0, 1.0, 0.0);
-                    vec3 p = centre + n * radius;
-                    float vis = 1.0;
-#if KILN_HAS_SHADOW_MAP
-                    vis = shadowHard(u_shadowMap, p + n * voxel, u_shadowBias);
-#endif
-                    fixedRgb = toFixedRadiance(inst.albedo.rgb / 3.14159265 * lampLight(p, n) * vis + inst.emissive.rgb);
+                    fixedRgb = toFixedRadiance(lampReflected(inst.albedo.rgb, centre + n * radius, n) + inst.emissive.rgb);
                 }
                 addToVoxel(ivec3(x, y, z), fixedRgb);
             }

@@ -8,6 +8,7 @@
 #include "common/light.glsl"
 #include "common/wood.glsl"
 #include "sums.glsl"
+#include "surface.glsl"
 
 in vec3 v_world;
 in vec3 v_normal;
@@ -16,10 +17,6 @@ flat in int v_axis;
 flat in vec4 v_aabb;
 flat in vec2 v_depthRange;
 
-layout(binding = 0) uniform sampler2D u_shadowMap;
-
-uniform int u_res;
-uniform float u_shadowBias;
 uniform float u_emissionScale;  // 1, or lamp_emission while drawing the lamp
 
 void main() {
@@ -30,11 +27,7 @@ void main() {
     vec3 albedo = inst.albedo.rgb;
     if (inst.albedo.a > 0.5) albedo = woodGrain(v_world);
     vec3 n = normalize(v_normal);
-    float vis = 1.0;
-#if KILN_HAS_SHADOW_MAP
-    vis = shadowHard(u_shadowMap, v_world + n * (2.0 / float(u_res)), u_shadowBias);
-#endif
-    vec3 radiance = albedo / 3.14159265 * lampLight(v_world, n) * vis + inst.emissive.rgb * u_emissionScale;
+    vec3 radiance = lampReflected(albedo, v_world, n) + inst.emissive.rgb * u_emissionScale;
     uvec3 fixedRgb = toFixedRadiance(radiance);
 
     // Depth along the projection axis at this pixel, and how much it varies across it.
