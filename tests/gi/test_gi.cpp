@@ -73,6 +73,49 @@ glm::vec3 worldOf(Rig& rig, const FloatImage& depth, int x, int y) {
 
 float luminance(const float* c) { return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]; }
 
+// The shipped scene 1 s in (the fire's particles spawned), `passes` (a voxelize among
+// them) loaded before a voxel_view of voxelize.radiance, one frame: its level 0.
+Volume voxelizedAtOneSecond(Rig& rig, const std::string& passes) {
+    while (rig.app.scene().time() < 1.0) rig.app.scene().step();
+    rig.load(pipeline("voxel_view.color", passes + R"(,
+        {"id": "voxel_view", "module": "voxel_view", "inputs": {"voxels": "voxelize.radiance"}})"));
+    rig.app.frame();
+    rig.checkNoErrors();
+    return read3d(rig.tex("voxelize", "radiance"), 0);
+}
+
+// A gi_volume `pattern` at res³ through voxel_mip in `mode`, shown by a voxel_view, one
+// frame; `keep` are the textures read back.
+void mipVolume(Rig& rig, const std::string& pattern, int res, const std::string& mode, std::vector<std::string> keep) {
+    rig.load(pipeline("voxel_view.color", R"(
+        {"id": "volume", "module": "gi_volume", "params": {"pattern": ")" + pattern + R"(", "resolution": )" +
+                                              std::to_string(res) + R"(}},
+        {"id": "voxel_mip", "module": "voxel_mip", "inputs": {"radiance": "volume.radiance"},
+         "params": {"mode": ")" + mode + R"("}},
+        {"id": "voxel_view", "module": "voxel_view", "inputs": {"voxels": "voxel_mip.iso"}})"),
+             std::move(keep));
+    rig.app.frame();
+    rig.checkNoErrors();
+}
+
+// The voxel holding world point p in a res³ volume over [-1,1]³.
+glm::ivec3 voxelOf(glm::vec3 p, int res) {
+    return glm::clamp(glm::ivec3(glm::floor((p * 0.5f + 0.5f) * float(res))), 0, res - 1);
+}
+
+// The light a volume holds (Σ rgb) and its occupied voxels (Σ a).
+struct VolumeTotals {
+    double light = 0, occupied = 0;
+};
+VolumeTotals totals(const Volume& vol) {
+    VolumeTotals t;
+    for (size_t i = 0; i < vol.v.size(); i += 4) {
+        t.light += vol.v[i] + vol.v[i + 1] + vol.v[i + 2];
+        t.occupied += vol.v[i + 3];
+    }
+    return t;
+}
+
 }  // namespace
 
 TEST_CASE("voxelize: the five walls are solid one-voxel layers, the inside and the open front empty",
@@ -218,14 +261,9 @@ TEST_CASE("voxelize: splatted particles land where the simulation has them and g
     std::vector<glm::vec3> centres;
     for (int mode = 0; mode < 2; ++mode) {
         Rig rig("", 64);
-        while (rig.app.scene().time() < 1.0) rig.app.scene().step();
-        rig.load(pipeline("voxel_view.color", std::string(R"(
+        vol[mode] = voxelizedAtOneSecond(rig, std::string(R"(
             {"id": "voxelize", "module": "voxelize", "params": {"resolution": 32, "particle_mode": ")") +
-                                                  (mode ? "splat" : "mesh") + R"("}},
-            {"id": "voxel_view", "module": "voxel_view", "inputs": {"voxels": "voxelize.radiance"}})"));
-        rig.app.frame();
-        rig.checkNoErrors();
-        vol[mode] = read3d(rig.tex("voxelize", "radiance"), 0);
+                                                  (mode ? "splat" : "mesh") + R"("}})");
         centres.clear();
         for (auto& p : rig.app.scene().sim().particles())
             if (p.life > 0) centres.emplace_back(float(p.position.x), float(p.position.y), float(p.position.z));
@@ -234,35 +272,30 @@ TEST_CASE("voxelize: splatted particles land where the simulation has them and g
     for (int mode = 0; mode < 2; ++mode) {
         size_t missing = 0;
         for (auto& c : centres) {
-            const glm::ivec3 v = glm::clamp(glm::ivec3(glm::floor((c * 0.5f + 0.5f) * 32.0f)), 0, 31);
+            const glm::ivec3 v = voxelOf(c, 32);
             missing += vol[mode].at(v.x, v.y, v.z)[3] < 0.5f;
         }
         INFO((mode ? "splat" : "mesh") << ": " << missing << " of " << centres.size() << " particle voxels empty");
         CHECK(missing == 0);
     }
-    double light[2] = {0, 0}, occupied[2] = {0, 0};
-    for (int mode = 0; mode < 2; ++mode)
-        for (size_t i = 0; i < vol[mode].v.size(); i += 4) {
-            light[mode] += vol[mode].v[i] + vol[mode].v[i + 1] + vol[mode].v[i + 2];
-            occupied[mode] += vol[mode].v[i + 3];
-        }
-    WARN("sum rgb mesh " << light[0] << " splat " << light[1] << "; occupied voxels mesh " << occupied[0] << " splat "
-                         << occupied[1]);
+    const VolumeTotals mesh = totals(vol[0]), splat = totals(vol[1]);
+    WARN("sum rgb mesh " << mesh.light << " splat " << splat.light << "; occupied voxels mesh " << mesh.occupied
+                         << " splat " << splat.occupied);
     // Both hold the same walls, bodies and lamp; they differ only in the particles'
     // footprint (a conservative triangle reaches half a voxel further than the
     // particle's bounding box) and in how many fragments a particle adds to a voxel it
     // shares with a surface. Measured: Σ rgb 4 762 (mesh) and 4 771 (splat), 6 216 and
     // 6 206 voxels; bounds 5 % and 3 % leave room for other particle counts while
     // still failing a splat that drops, doubles or misplaces the particles.
-    CHECK(light[1] == Approx(light[0]).epsilon(0.05));
-    CHECK(occupied[1] == Approx(occupied[0]).epsilon(0.03));
+    CHECK(splat.light == Approx(mesh.light).epsilon(0.05));
+    CHECK(splat.occupied == Approx(mesh.occupied).epsilon(0.03));
 }
 
 TEST_CASE("voxelize: splatted fireballs fill the voxels their surfaces pass through, lit like their meshes",
           "[gi][voxelize]") {
     // The shipped scene 1 s in, its particles splatted (one dispatch with the fireballs),
-    // voxelized with fireball_mode mesh (the sphere rasterized) and splat, at 32³ (a fireball about two voxels wide) and
-    // 64³ (four). Against the simulation: every voxel holding a point of a fireball's
+    // voxelized with fireball_mode mesh (the sphere rasterized) and splat, at 32³ (a
+    // fireball about two voxels wide) and 64³ (four). Against the simulation: every voxel holding a point of a fireball's
     // surface (26 directions) is occupied in both. Against each other: the light and
     // the occupied voxels of the whole volume, and the light within a voxel of each
     // fireball.
@@ -271,16 +304,11 @@ TEST_CASE("voxelize: splatted fireballs fill the voxels their surfaces pass thro
         std::vector<std::pair<glm::vec3, float>> fireballs;
         for (int mode = 0; mode < 2; ++mode) {
             Rig rig("", 64);
-            while (rig.app.scene().time() < 1.0) rig.app.scene().step();
-            rig.load(pipeline("voxel_view.color", R"(
+            vol[mode] = voxelizedAtOneSecond(rig, R"(
                 {"id": "shadow", "module": "shadow", "params": {"size": 256}},
                 {"id": "voxelize", "module": "voxelize", "inputs": {"shadow_map": "shadow.depth"},
                  "params": {"resolution": )" + std::to_string(res) + R"(, "fireball_mode": ")" +
-                                                      (mode ? "splat" : "mesh") + R"("}},
-                {"id": "voxel_view", "module": "voxel_view", "inputs": {"voxels": "voxelize.radiance"}})"));
-            rig.app.frame();
-            rig.checkNoErrors();
-            vol[mode] = read3d(rig.tex("voxelize", "radiance"), 0);
+                                                      (mode ? "splat" : "mesh") + R"("}})");
             fireballs.clear();
             for (auto& b : rig.app.scene().sim().balls())
                 if (b.kind == sim::BallKind::Fireball)
@@ -288,7 +316,6 @@ TEST_CASE("voxelize: splatted fireballs fill the voxels their surfaces pass thro
                                            float(b.radius));
         }
         REQUIRE(fireballs.size() == 2);
-        auto voxelOf = [&](glm::vec3 p) { return glm::clamp(glm::ivec3(glm::floor((p * 0.5f + 0.5f) * float(res))), 0, res - 1); };
         for (int mode = 0; mode < 2; ++mode) {
             int missing = 0;
             for (auto& [c, r] : fireballs)
@@ -296,28 +323,25 @@ TEST_CASE("voxelize: splatted fireballs fill the voxels their surfaces pass thro
                     for (int dy = -1; dy <= 1; ++dy)
                         for (int dx = -1; dx <= 1; ++dx) {
                             if (!dx && !dy && !dz) continue;
-                            const glm::ivec3 v = voxelOf(c + r * glm::normalize(glm::vec3(dx, dy, dz)));
+                            const glm::ivec3 v = voxelOf(c + r * glm::normalize(glm::vec3(dx, dy, dz)), res);
                             missing += vol[mode].at(v.x, v.y, v.z)[3] < 0.5f;
                         }
             INFO(res << "³ " << (mode ? "splat" : "mesh") << ": " << missing << " of " << 26 * fireballs.size()
                      << " surface voxels empty");
             CHECK(missing == 0);
         }
-        double light[2] = {0, 0}, occupied[2] = {0, 0}, near[2] = {0, 0};
-        for (int mode = 0; mode < 2; ++mode) {
-            for (size_t i = 0; i < vol[mode].v.size(); i += 4) {
-                light[mode] += vol[mode].v[i] + vol[mode].v[i + 1] + vol[mode].v[i + 2];
-                occupied[mode] += vol[mode].v[i + 3];
-            }
+        double near[2] = {0, 0};
+        for (int mode = 0; mode < 2; ++mode)
             for (auto& [c, r] : fireballs) {
-                const glm::ivec3 lo = voxelOf(c - glm::vec3(r + 2.0f / float(res))), hi = voxelOf(c + glm::vec3(r + 2.0f / float(res)));
+                const glm::vec3 reach(r + 2.0f / float(res));
+                const glm::ivec3 lo = voxelOf(c - reach, res), hi = voxelOf(c + reach, res);
                 for (int z = lo.z; z <= hi.z; ++z)
                     for (int y = lo.y; y <= hi.y; ++y)
                         for (int x = lo.x; x <= hi.x; ++x) near[mode] += vol[mode].at(x, y, z)[0];
             }
-        }
-        WARN(res << "³: sum rgb mesh " << light[0] << " splat " << light[1] << "; occupied mesh " << occupied[0]
-                 << " splat " << occupied[1] << "; red near the fireballs mesh " << near[0] << " splat " << near[1]);
+        const VolumeTotals mesh = totals(vol[0]), splat = totals(vol[1]);
+        WARN(res << "³: sum rgb mesh " << mesh.light << " splat " << splat.light << "; occupied mesh " << mesh.occupied
+                 << " splat " << splat.occupied << "; red near the fireballs mesh " << near[0] << " splat " << near[1]);
         // Measured: Σ rgb 4 718 / 4 627 (32³) and 19 415 / 19 206 (64³); occupied 6 204 /
         // 6 203 and 25 795 / 25 791. Near the fireballs the splat holds less red (82 % at
         // 32³, 89 % at 64³): it adds one fragment per voxel where the rasterized mesh's
@@ -325,8 +349,8 @@ TEST_CASE("voxelize: splatted fireballs fill the voxels their surfaces pass thro
         // particles or a wall it weighs less. Bounds: 5 % and 1 % for the whole volume; 70–
         // 105 % near the fireballs, which still fails a splat that drops the fireballs
         // (measured: 61 % and 47 %, their particles stay) or adds them twice.
-        CHECK(light[1] == Approx(light[0]).epsilon(0.05));
-        CHECK(occupied[1] == Approx(occupied[0]).epsilon(0.01));
+        CHECK(splat.light == Approx(mesh.light).epsilon(0.05));
+        CHECK(splat.occupied == Approx(mesh.occupied).epsilon(0.01));
         CHECK(near[1] > 0.70 * near[0]);
         CHECK(near[1] < 1.05 * near[0]);
     }
@@ -421,14 +445,7 @@ TEST_CASE("voxel_mip: every level of a constant volume equals it (iso and all si
     // Tolerance 2e-3: RGBA16F stores 0.6 with a spacing of 2^-11·0.6 ≈ 3e-4, and an
     // average of equal values (or a composite over an opaque front) is that value.
     Rig rig(writeScene("empty_box.json", kEmptyBox), 32);
-    rig.load(pipeline("voxel_view.color", R"(
-        {"id": "volume", "module": "gi_volume", "params": {"pattern": "solid", "resolution": 32}},
-        {"id": "voxel_mip", "module": "voxel_mip", "inputs": {"radiance": "volume.radiance"},
-         "params": {"mode": "aniso"}},
-        {"id": "voxel_view", "module": "voxel_view", "inputs": {"voxels": "voxel_mip.iso"}})"),
-             {"voxel_mip.aniso"});
-    rig.app.frame();
-    rig.checkNoErrors();
+    mipVolume(rig, "solid", 32, "aniso", {"voxel_mip.aniso"});
     const float expect[4] = {0.6f, 0.3f, 0.15f, 1.0f};
     const TextureRef& iso = rig.tex("voxel_mip", "iso");
     const TextureRef& aniso = rig.tex("voxel_mip", "aniso");
@@ -465,14 +482,7 @@ TEST_CASE("voxel_mip: anisotropic levels composite front to back along their dir
     //   iso: the mean      = (0.25, 0.5, 0, 0.75)
     // Tolerance 2e-3 (half floats, see above).
     Rig rig(writeScene("empty_box.json", kEmptyBox), 32);
-    rig.load(pipeline("voxel_view.color", R"(
-        {"id": "volume", "module": "gi_volume", "params": {"pattern": "layers", "resolution": 16}},
-        {"id": "voxel_mip", "module": "voxel_mip", "inputs": {"radiance": "volume.radiance"},
-         "params": {"mode": "aniso"}},
-        {"id": "voxel_view", "module": "voxel_view", "inputs": {"voxels": "voxel_mip.iso"}})"),
-             {"voxel_mip.aniso"});
-    rig.app.frame();
-    rig.checkNoErrors();
+    mipVolume(rig, "layers", 16, "aniso", {"voxel_mip.aniso"});
     const glm::vec4 expect[6] = {{0.5f, 0.5f, 0, 1},         {0, 1, 0, 1},
                                  {0.375f, 0.5f, 0, 0.875f}, {0.375f, 0.5f, 0, 0.875f},
                                  {0.375f, 0.5f, 0, 0.875f}, {0.375f, 0.5f, 0, 0.875f}};
@@ -514,14 +524,7 @@ TEST_CASE("voxel_mip fixed_cones: each direction's chain is the d²-weighted ble
     // Every level of every tile is also checked against the aniso chains read back and
     // blended here. Tolerance 2e-3: half floats (see above).
     Rig rig(writeScene("empty_box.json", kEmptyBox), 32);
-    rig.load(pipeline("voxel_view.color", R"(
-        {"id": "volume", "module": "gi_volume", "params": {"pattern": "layers", "resolution": 16}},
-        {"id": "voxel_mip", "module": "voxel_mip", "inputs": {"radiance": "volume.radiance"},
-         "params": {"mode": "fixed_cones"}},
-        {"id": "voxel_view", "module": "voxel_view", "inputs": {"voxels": "voxel_mip.iso"}})"),
-             {"voxel_mip.aniso", "voxel_mip.fixed_cones"});
-    rig.app.frame();
-    rig.checkNoErrors();
+    mipVolume(rig, "layers", 16, "fixed_cones", {"voxel_mip.aniso", "voxel_mip.fixed_cones"});
     const TextureRef& fixed = rig.tex("voxel_mip", "fixed_cones");
     const TextureRef& aniso = rig.tex("voxel_mip", "aniso");
     REQUIRE(fixed.width == 12 * 8);
