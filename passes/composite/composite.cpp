@@ -1,5 +1,6 @@
 // composite — the final image: direct light from the lamp (the cap emitter of
-// shaders/common/light.glsl, `lamp_samples` quadrature points) on the G-buffer (5×5 PCF
+// shaders/common/light.glsl: its silhouette's contour integral, or `lamp_samples`
+// quadrature points) on the G-buffer (5×5 PCF
 // shadows from `shadow_map`), plus albedo × indirect irradiance (cone_trace), emission
 // and bloom; tonemap and gamma. Bloom is computed before this pass from the G-buffer's
 // emitted radiance (see passes/bloom), so no separate "lighting" pass is needed.
@@ -31,8 +32,11 @@ public:
                                   "shadow filter about k+1 texels wide from ((k+1)/2)² bilinear depth comparisons; 1 = one"))
             .param(floatParam("indirect_strength", 1.0f, 0.0, 8.0, "scales the bound indirect irradiance (1 = physical)"))
             .param(floatParam("shadow_bias", 0.0005f, 0.0, 0.05, "depth bias of the shadow test"))
+            .param(enumParam("lamp_model", "contour", {"contour", "points"},
+                             "the lamp's irradiance: contour = its silhouette as a polygon (exact up to the "
+                             "polygon, also next to the dome); points = a quadrature over the cap (lobes near it)"))
             .param(intChoiceParam("lamp_samples", 32, {4, 8, 16, 32, 64},
-                                  "quadrature points over the lamp's cap for its direct light"));
+                                  "vertices of the lamp's silhouette (contour) or quadrature points over its cap (points)"));
         d.reads = kSceneLight | kSceneCamera;
         return d;
     }
@@ -40,6 +44,7 @@ public:
     void execute(kiln::PassContext& ctx) override {
         GLuint program = ctx.program({.stages = {"common/fullscreen.vert", "composite/composite.frag"},
                                       .defines = {{"KILN_LAMP_SAMPLES", std::to_string(ctx.getInt("lamp_samples"))},
+                                                  {"KILN_LAMP_CONTOUR", ctx.getEnum("lamp_model") == "contour" ? "1" : "0"},
                                                   {"KILN_PCF", std::to_string(ctx.getInt("pcf"))}}});
         if (!program) return;
         if (!ctx.framebuffer({"color", "hdr"})) return;
