@@ -28,12 +28,52 @@
 //          fetches per cone step per pixel.
 // Chains a mode does not build are cleared to zero once and left alone; binding one
 // is a pipeline error (producedWhen), so no cone reads them.
+//
+// Bounces (issue 22). voxelize's radiance holds direct light and emission, so the
+// pixels' cones gather one bounce; in a closed, bright box the later ones are a large
+// share (one bounce showed 0.62× the reference's indirect light). With bounces = k > 1
+// and voxelize's `albedo` and `normal` bound, the chains are built, then k − 1 times:
+// every block of gather_block³ voxels that holds a surface traces the fixed cone set
+// through them (shaders/voxel_mip/bounce.comp), level 0 becomes the input plus albedo ×
+// that mean incoming radiance, and the chains are rebuilt from it. Deterministic and
+// bounded: each bounce adds at most albedo × the last one (no feedback across frames,
+// nothing to converge or to lag behind motion), so the frame shows exactly k bounces
+// and the path tracer with max_bounces = k + 1 is its ground truth
+// (tests/gi/test_bounces.cpp, with the white furnace's 2 − 0.5^k).
 #include <kiln/pass.hpp>
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <string>
 
 namespace {
+
+// The voxels' gather (bounce.comp) marches its cones as cone_trace does with its
+// defaults: 60° cones on the octave schedule (one lookup per mip level, where the
+// cone's diameter is that level's voxel, 0.87 diameters apart), pushed one voxel off the
+// surface and half of each sample's diameter further.
+constexpr float kGatherStartOffset = 1.0f;
+constexpr float kGatherDiameterOffset = 0.5f;
+kiln::Defines gatherDefines(kiln::PassContext& ctx, int res) {
+    const float voxel = 2.0f / float(res), tanHalf = std::tan(float(M_PI) / 6.0f), maxDistance = 2.0f;
+    std::string list;
+    int steps = 0;
+    for (int level = 0; (1 << level) <= res; ++level) {
+        const float diameter = voxel * float(1 << level), t = diameter / (2.0f * tanHalf);
+        if (t >= maxDistance) break;
+        char step[128];
+        std::snprintf(step, sizeof step, "%svec4(%.6f, %.6f, %d.0, %.6f)", steps++ ? ", " : "", t, diameter, level,
+                      t / diameter);  // spacing to the next = t (the diameter doubles)
+        list += step;
+    }
+    const std::string& mode = ctx.getEnum("mode");
+    return {{"KILN_GATHER_BLOCK", std::to_string(ctx.getInt("gather_block"))},
+            {"KILN_CONE_STEPS", std::to_string(steps)},
+            {"KILN_CONE_SCHEDULE", list},
+            {"KILN_HAS_ANISO", mode == "aniso" ? "1" : "0"},
+            {"KILN_HAS_FIXED_CONES", mode == "fixed_cones" ? "1" : "0"}};
+}
 
 class VoxelMip final : public kiln::Pass {
 public:
@@ -42,6 +82,10 @@ public:
         PassDeclaration d;
         const auto cube = SizeRule::fromInput("radiance");
         d.input({.name = "radiance", .kind = TextureKind::Color3D, .doc = "voxelize.radiance"})
+            .input({.name = "albedo", .kind = TextureKind::Color3D, .required = false,
+                    .doc = "voxelize.albedo: what each voxel reflects (needed for bounces > 1)"})
+            .input({.name = "normal", .kind = TextureKind::Color3D, .required = false,
+                    .doc = "voxelize.normal: which way it faces (needed for bounces > 1)"})
             .output({.name = "iso", .kind = TextureKind::Color3D, .format = Format::RGBA16F, .size = cube,
                      .mips = kFullMipChain, .doc = "isotropic chain; level 0 = the input"})
             .output({.name = "aniso", .kind = TextureKind::Color3D, .format = Format::RGBA16F, .size = cube,
@@ -53,9 +97,20 @@ public:
                      .doc = "the aniso chains blended for each of the 12 fixed cone directions (tiles along x); "
                             "level k = directional level k+1",
                      .producedWhen = {"mode", {"fixed_cones"}}})
+            .internal({.name = "bounced", .kind = TextureKind::Color3D, .format = Format::RGBA16F, .size = cube,
+                       .doc = "bounces > 1: level 0 with one more bounce, before it replaces iso's"})
             .param(enumParam("mode", "aniso", {"iso", "aniso", "fixed_cones"},
                              "iso: the isotropic chain only; aniso: the six directional chains too; "
-                             "fixed_cones: those blended per fixed cone direction as well"));
+                             "fixed_cones: those blended per fixed cone direction as well"))
+            .param(intParam("bounces", 1, 1, 8,
+                            "diffuse bounces the frame shows: 1 = the voxels hold direct light and emission (the "
+                            "pixels gather one bounce); each more is gathered in the voxels first"))
+            .param(intChoiceParam("gather_block", 2, {1, 2},
+                                  "bounces > 1: voxels per side that gather once together (2: an eighth of the cones)"))
+            .param(floatParam("gather_start_offset", kGatherStartOffset, 0.0, 4.0,
+                              "bounces > 1: a voxel's cones start this many voxels off its surface"))
+            .param(floatParam("gather_diameter_offset", kGatherDiameterOffset, 0.0, 2.0,
+                              "bounces > 1: each sample pushed off the surface by this × its diameter"));
         return d;
     }
 
@@ -66,14 +121,54 @@ public:
         if (!iso || !aniso || !blend) return;
         const kiln::TextureRef& in = ctx.input("radiance");
         const kiln::TextureRef& chain = ctx.output("iso");
-        const kiln::TextureRef& atlas = ctx.output("aniso");
-        const kiln::TextureRef& fixed = ctx.output("fixed_cones");
-        const std::string& mode = ctx.getEnum("mode");
+        const int bounces = ctx.getInt("bounces");
+        if (bounces > 1 && !(ctx.isBound("albedo") && ctx.isBound("normal")))
+            return ctx.fail("bounces " + std::to_string(bounces) +
+                            " needs `albedo` and `normal` bound (voxelize.albedo, voxelize.normal): what each voxel "
+                            "reflects, and which way");
+        GLuint bounce = bounces > 1 ? ctx.program({.stages = {"voxel_mip/bounce.comp"}, .defines = gatherDefines(ctx, chain.width)}) : 0;
+        if (bounces > 1 && !bounce) return;
         const int res = chain.width;  // = the input's (SizeRule::fromInput)
         glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
         glCopyImageSubData(in.id, GL_TEXTURE_3D, 0, 0, 0, 0, chain.id, GL_TEXTURE_3D, 0, 0, 0, 0, res, res, res);
+        buildChains(ctx, iso, aniso, blend);
 
-        auto groups = [](int n) { return GLuint((n + 3) / 4); };
+        // Each further bounce: gather through the chains just built into `bounced`, make
+        // it level 0, rebuild the chains from it.
+        for (int b = 2; b <= bounces; ++b) {
+            const kiln::TextureRef& bounced = ctx.internal("bounced");
+            glUseProgram(bounce);
+            glUniform1f(glGetUniformLocation(bounce, "u_voxelRes"), float(res));
+            glUniform1f(glGetUniformLocation(bounce, "u_startOffset"), ctx.getFloat("gather_start_offset"));
+            glUniform1f(glGetUniformLocation(bounce, "u_diameterOffset"), ctx.getFloat("gather_diameter_offset"));
+            glBindTextureUnit(0, in.id);
+            glBindTextureUnit(1, ctx.input("albedo").id);
+            glBindTextureUnit(4, ctx.input("normal").id);
+            glBindTextureUnit(2, chain.id);
+            glBindTextureUnit(3, ctx.output("aniso").id);
+            glBindTextureUnit(6, ctx.output("fixed_cones").id);
+            glBindImageTexture(0, bounced.id, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA16F);
+            const int blocks = res / ctx.getInt("gather_block");
+            glDispatchCompute(groups(blocks), groups(blocks), groups(blocks));
+            glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+            glCopyImageSubData(bounced.id, GL_TEXTURE_3D, 0, 0, 0, 0, chain.id, GL_TEXTURE_3D, 0, 0, 0, 0, res, res, res);
+            buildChains(ctx, iso, aniso, blend);
+        }
+        glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+        glBindImageTexture(0, 0, 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA16F);
+        glBindImageTexture(1, 0, 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA16F);
+    }
+
+private:
+    static GLuint groups(int n) { return GLuint((n + 3) / 4); }
+
+    // Every chain the mode builds, from iso's level 0.
+    void buildChains(kiln::PassContext& ctx, GLuint iso, GLuint aniso, GLuint blend) {
+        const kiln::TextureRef& chain = ctx.output("iso");
+        const kiln::TextureRef& atlas = ctx.output("aniso");
+        const kiln::TextureRef& fixed = ctx.output("fixed_cones");
+        const std::string& mode = ctx.getEnum("mode");
+        const int res = chain.width;
         glUseProgram(iso);
         for (int level = 1; level < chain.levels; ++level) {
             const int n = std::max(1, res >> level);
@@ -120,11 +215,8 @@ public:
             fixedCleared_ = true;
         }
         glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
-        glBindImageTexture(0, 0, 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA16F);
-        glBindImageTexture(1, 0, 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA16F);
     }
 
-private:
     static void clearAllLevels(const kiln::TextureRef& t) {
         for (int l = 0; l < t.levels; ++l) glClearTexImage(t.id, l, GL_RGBA, GL_FLOAT, nullptr);
     }

@@ -38,13 +38,17 @@
 //   4. A compute pass (4³ groups) resolves sum/count into `radiance`: rgb = the mean
 //      outgoing radiance, a = occupancy (1 where any fragment landed, else 0). The
 //      colour is premultiplied by the occupancy (empty voxels are 0,0,0,0), which is
-//      what the mip passes average and what the cone tracer composites.
+//      what the mip passes average and what the cone tracer composites. Surfaces also
+//      add their albedo and normal (six more sums), resolved into `albedo` and
+//      `normal`: what voxel_mip needs to bounce the light the voxels hold.
 //
 // Cleared and rebuilt whenever it runs; the host skips it when neither the scene
 // (static geometry, bodies, particles, light) nor the shadow map changed.
 #include <kiln/pass.hpp>
 
 #include <cmath>
+#include <iterator>
+#include <string_view>
 
 namespace {
 
@@ -62,11 +66,13 @@ public:
                  .doc = "the lamp's depth map (shadow.depth); unbound: everything lit"})
             .output({.name = "radiance", .kind = TextureKind::Color3D, .format = Format::RGBA16F, .size = cube,
                      .doc = "rgb = mean outgoing radiance × occupancy, a = occupancy (0/1)"})
-            .internal({.name = "sum_r", .kind = TextureKind::Color3D, .format = Format::R32UI, .size = cube})
-            .internal({.name = "sum_g", .kind = TextureKind::Color3D, .format = Format::R32UI, .size = cube})
-            .internal({.name = "sum_b", .kind = TextureKind::Color3D, .format = Format::R32UI, .size = cube})
-            .internal({.name = "count", .kind = TextureKind::Color3D, .format = Format::R32UI, .size = cube})
-            .param(intChoiceParam("resolution", 64, {32, 64, 128}, "voxels per side over [-1,1]^3"))
+            .output({.name = "albedo", .kind = TextureKind::Color3D, .format = Format::RGBA8, .size = cube,
+                     .doc = "rgb = the surfaces' mean albedo (particles count as 0), a = occupancy"})
+            .output({.name = "normal", .kind = TextureKind::Color3D, .format = Format::RGBA16F, .size = cube,
+                     .doc = "xyz = the surfaces' mean unit normal (shorter where they disagree), a = occupancy"});
+        for (const char* sum : kSums)
+            d.internal({.name = sum, .kind = TextureKind::Color3D, .format = Format::R32UI, .size = cube});
+        d.param(intChoiceParam("resolution", 64, {32, 64, 128}, "voxels per side over [-1,1]^3"))
             .param(boolParam("conservative", true, "enlarge triangles by half a voxel (no holes from thin triangles)"))
             .param(boolParam("marbles", false, "voxelize the marbles too (the seed leaves them out)"))
             .param(boolParam("particles", true, "voxelize the emissive particles"))
@@ -81,24 +87,31 @@ public:
             .param(floatParam("lamp_emission", 0.0f, 0.0, 1.0,
                               "scale of the lamp dome's own emission in the voxels (its light already arrives "
                               "through composite's direct term: 1 counts it twice)"))
+            .param(enumParam("lamp_model", "contour", {"contour", "points"},
+                             "the lamp's irradiance on voxelized surfaces (shaders/common/light.glsl): its "
+                             "silhouette's contour integral (16 vertices), or 32 quadrature points over the cap"))
             .param(floatParam("shadow_bias", 0.002f, 0.0, 0.05, "depth bias of the (hard) shadow test"));
         d.reads = kSceneStatic | kSceneBodies | kSceneParticles | kSceneLight;
         return d;
     }
 
     void execute(kiln::PassContext& ctx) override {
-        GLuint raster = ctx.program({.stages = {"voxelize/voxelize.vert", "voxelize/voxelize.geom", "voxelize/voxelize.frag"}});
+        // 16 silhouette vertices (within 0.8 % of the exact irradiance; tests/gi/test_lamp.cpp)
+        // or the old 32 quadrature points.
+        const bool contour = ctx.getEnum("lamp_model") == "contour";
+        const kiln::Defines lamp = {{"KILN_LAMP_CONTOUR", contour ? "1" : "0"}, {"KILN_LAMP_SAMPLES", contour ? "16" : "32"}};
+        GLuint raster = ctx.program({.stages = {"voxelize/voxelize.vert", "voxelize/voxelize.geom", "voxelize/voxelize.frag"},
+                                     .defines = lamp});
         GLuint resolve = ctx.program({.stages = {"voxelize/resolve.comp"}});
         const bool particles = ctx.getBool("particles");
         const bool splatParticles = particles && ctx.getEnum("particle_mode") == "splat";
         const bool splatFireballs = ctx.getEnum("fireball_mode") == "splat";
-        GLuint splatter = splatParticles || splatFireballs ? ctx.program({.stages = {"voxelize/splat.comp"}}) : 0;
+        GLuint splatter = splatParticles || splatFireballs ? ctx.program({.stages = {"voxelize/splat.comp"}, .defines = lamp}) : 0;
         if (!raster || !resolve || ((splatParticles || splatFireballs) && !splatter)) return;
         const kiln::TextureRef& out = ctx.output("radiance");
-        const char* sums[4] = {"sum_r", "sum_g", "sum_b", "count"};
         const int res = out.width;
 
-        for (int i = 0; i < 4; ++i) glClearTexImage(ctx.internal(sums[i]).id, 0, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
+        for (const char* sum : kSums) glClearTexImage(ctx.internal(sum).id, 0, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
 
         // 1–3: rasterise into the sums (no attachments: the fragment shader only does atomics).
         if (!fbo_) glCreateFramebuffers(1, &fbo_);
@@ -117,8 +130,7 @@ public:
         glUniform1f(glGetUniformLocation(raster, "u_conservative"), ctx.getBool("conservative") ? 1.0f : 0.0f);
         glUniform1f(glGetUniformLocation(raster, "u_shadowBias"), ctx.getFloat("shadow_bias"));
         glBindTextureUnit(0, ctx.input("shadow_map").id);
-        for (int i = 0; i < 4; ++i)
-            glBindImageTexture(GLuint(i), ctx.internal(sums[i]).id, 0, GL_TRUE, 0, GL_READ_WRITE, GL_R32UI);
+        bindSums(ctx, GL_READ_WRITE);
         uint32_t cats = kiln::kSceneBox | kiln::kSceneTumblers;
         if (!splatFireballs) cats |= kiln::kSceneFireballs;
         if (particles && !splatParticles) cats |= kiln::kSceneParticles;
@@ -157,16 +169,28 @@ public:
         // 4: resolve the averages.
         glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
         glUseProgram(resolve);
-        for (int i = 0; i < 4; ++i)
-            glBindImageTexture(GLuint(i), ctx.internal(sums[i]).id, 0, GL_TRUE, 0, GL_READ_ONLY, GL_R32UI);
-        glBindImageTexture(4, out.id, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA16F);
+        bindSums(ctx, GL_READ_ONLY);
+        const GLuint firstResolved = GLuint(std::size(kSums));
+        glBindImageTexture(firstResolved, out.id, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA16F);
+        glBindImageTexture(firstResolved + 1, ctx.output("albedo").id, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA8);
+        glBindImageTexture(firstResolved + 2, ctx.output("normal").id, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA16F);
         const GLuint groups = GLuint((res + 3) / 4);
         glDispatchCompute(groups, groups, groups);
         glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
-        for (GLuint i = 0; i < 5; ++i) glBindImageTexture(i, 0, 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32UI);
+        for (GLuint i = 0; i < firstResolved + 3; ++i) glBindImageTexture(i, 0, 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32UI);
     }
 
 private:
+    // The accumulators of shaders/voxelize/sums.glsl, in its image-unit order. The
+    // normal's are signed: R32UI storage viewed as R32I (same size class).
+    static constexpr const char* kSums[] = {"sum_r",    "sum_g",    "sum_b",    "count",   "albedo_r",
+                                            "albedo_g", "albedo_b", "normal_x", "normal_y", "normal_z"};
+    static void bindSums(kiln::PassContext& ctx, GLenum access) {
+        for (GLuint i = 0; i < std::size(kSums); ++i)
+            glBindImageTexture(i, ctx.internal(kSums[i]).id, 0, GL_TRUE, 0, access,
+                               std::string_view(kSums[i]).starts_with("normal") ? GL_R32I : GL_R32UI);
+    }
+
     GLuint fbo_ = 0;  // attachment-less; a GL cache only (a reload makes a new one)
     int fboSize_ = 0;
 };

@@ -8,7 +8,7 @@
 //   fireballs  emission plus the lamp's light on the surface point facing the voxel's
 //              centre, lit as voxelize.frag lights a fragment (surface.glsl): the first
 //              u_litCount spheres.
-//   particles  emitters with no albedo: their emission; the rest.
+//   particles  emitters with no albedo: their emission, no surface (albedo, normal); the rest.
 // The spheres are the instances [u_first, u_first + u_sphereCount) of the scene's
 // instance buffer. Cost: a few atomics per voxel of the shell, where rasterizing the mesh cost a
 // geometry-shader invocation per triangle.
@@ -41,12 +41,13 @@ void main() {
                 float nearest = distance(clamp(centre, cubeLo, cubeHi), centre);
                 float farthest = length(max(abs(cubeLo - centre), abs(cubeHi - centre)));
                 if (nearest > radius || farthest < radius) continue;
-                uvec3 fixedRgb = emitted;
                 if (gl_GlobalInvocationID.x < u_litCount) {
                     vec3 towards = 0.5 * (cubeLo + cubeHi) - centre;
                     vec3 n = dot(towards, towards) > 1e-12 ? normalize(towards) : vec3(0.0, 1.0, 0.0);
-                    fixedRgb = toFixedRadiance(lampReflected(inst.albedo.rgb, centre + n * radius, n) + inst.emissive.rgb);
+                    uvec3 lit = toFixedRadiance(lampReflected(inst.albedo.rgb, centre + n * radius, n) + inst.emissive.rgb);
+                    addSurfaceToVoxel(ivec3(x, y, z), lit, inst.albedo.rgb, n);
+                } else {
+                    addToVoxel(ivec3(x, y, z), emitted);
                 }
-                addToVoxel(ivec3(x, y, z), fixedRgb);
             }
 }

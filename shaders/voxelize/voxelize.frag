@@ -40,6 +40,7 @@ void main() {
     ivec2 ij = clamp(ivec2(px), ivec2(0), ivec2(u_res - 1));
     for (int k = k0; k <= min(k1, k0 + 2); ++k) {
         // Back from (2D, depth) to (x, y, z): the inverse of the geometry shader's swizzle.
-        addToVoxel(v_axis == 0 ? ivec3(k, ij.x, ij.y) : v_axis == 1 ? ivec3(ij.y, k, ij.x) : ivec3(ij, k), fixedRgb);
+        addSurfaceToVoxel(v_axis == 0 ? ivec3(k, ij.x, ij.y) : v_axis == 1 ? ivec3(ij.y, k, ij.x) : ivec3(ij, k), fixedRgb,
+                          albedo, n);
     }
 }

@@ -1,0 +1,75 @@
+#version 450 core
+// voxel_mip, one more bounce (passes/voxel_mip/voxel_mip.cpp): the surfaces in each
+// block of KILN_GATHER_BLOCK³ voxels gather the light arriving at them through the
+// chains built from the voxels' current radiance — the same cones and marching as the
+// pixels (cone_trace/trace.glsl) — and reflect it on top of what voxelize put there
+// (direct light and emission):
+//     L_k(v) = L_0(v) + albedo(v) · Ē_k−1(block of v),   Ē = cosine-weighted mean radiance = E/π.
+// One gather a block (2³: an eighth of the cones) is enough for light that has already
+// bounced: it is smooth over a voxel or two.
+// The cones: the fixed set's 12 directions (common/fixed_cones.glsl), 60° each, weighted
+// by the surfaces' mean normal m as a blend of a cosine lobe (|m| = 1: one flat surface)
+// and the whole sphere (|m| = 0: surfaces facing every way, e.g. a ball in the block):
+//     w(d) = |m| · max(m̂·d, 0) + (1 − |m|) / 4
+// (1/4: the mean of max(n·d, 0) over the sphere), normalised over the cones traced.
+#include "cone_trace/trace.glsl"
+#include "common/fixed_cones.glsl"
+
+layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
+layout(binding = 0) uniform sampler3D u_emitted;  // voxelize.radiance: direct light + emission
+layout(binding = 1) uniform sampler3D u_albedo;   // voxelize.albedo
+layout(binding = 4) uniform sampler3D u_normal;   // voxelize.normal
+layout(rgba16f, binding = 0) uniform writeonly image3D u_bounced;
+
+const int kBlock = KILN_GATHER_BLOCK;
+
+bool reflects(vec4 radiance, vec3 albedo) { return radiance.a > 0.0 && max(albedo.r, max(albedo.g, albedo.b)) > 0.0; }
+
+void main() {
+    ivec3 block = ivec3(gl_GlobalInvocationID);
+    int res = int(u_voxelRes);
+    if (any(greaterThanEqual(block * kBlock, ivec3(res)))) return;
+    // The block's surfaces: their mean normal, and where they are.
+    vec3 normalSum = vec3(0.0), centreSum = vec3(0.0);
+    float surfaces = 0.0;
+    for (int i = 0; i < kBlock * kBlock * kBlock; ++i) {
+        ivec3 v = block * kBlock + ivec3(i % kBlock, (i / kBlock) % kBlock, i / (kBlock * kBlock));
+        if (!reflects(texelFetch(u_emitted, v, 0), texelFetch(u_albedo, v, 0).rgb)) continue;
+        normalSum += texelFetch(u_normal, v, 0).xyz;
+        centreSum += (vec3(v) + 0.5) / u_voxelRes * 2.0 - 1.0;
+        surfaces += 1.0;
+    }
+    vec3 gathered = vec3(0.0);
+    if (surfaces > 0.0) {
+        vec3 m = normalSum / surfaces;
+        float facing = min(length(m), 1.0);
+        vec3 n = facing > 1e-3 ? normalize(m) : vec3(0.0, 1.0, 0.0);
+        vec3 centre = centreSum / surfaces;
+        // The cones to trace as a bit mask, walked with findLSB: llvmpipe runs an `if`
+        // body for every lane but leaves a loop once no lane has work (a wall's blocks
+        // trace 4 cones, not 12).
+        uint cones = 0u;
+        for (int t = 0; t < kFixedConeTiles; ++t)
+            if (facing * max(dot(n, fixedConeDirection(t)), 0.0) + (1.0 - facing) * 0.25 >= 1e-3) cones |= 1u << t;
+        vec3 sum = vec3(0.0);
+        float weights = 0.0;
+        for (; cones != 0u; cones &= cones - 1u) {
+            int t = findLSB(cones);
+            vec3 d = fixedConeDirection(t);
+            float w = facing * max(dot(n, d), 0.0) + (1.0 - facing) * 0.25;
+            // Off the surfaces: along their normal, or along the cone where they face
+            // every way.
+            vec3 away = facing >= 0.5 ? n : d;
+            sum += w * traceCone(centre + away * (u_startOffset * 2.0 / u_voxelRes), away, d, t).rgb;
+            weights += w;
+        }
+        gathered = sum / max(weights, 1e-6);
+    }
+    for (int i = 0; i < kBlock * kBlock * kBlock; ++i) {
+        ivec3 v = block * kBlock + ivec3(i % kBlock, (i / kBlock) % kBlock, i / (kBlock * kBlock));
+        vec4 radiance = texelFetch(u_emitted, v, 0);
+        vec3 albedo = texelFetch(u_albedo, v, 0).rgb;
+        if (reflects(radiance, albedo)) radiance.rgb += albedo * gathered * radiance.a;
+        imageStore(u_bounced, v, radiance);
+    }
+}

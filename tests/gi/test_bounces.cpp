@@ -1,0 +1,143 @@
+// Multi-bounce voxel GI (voxel_mip.bounces) against what is known without it: the
+// white furnace's geometric series, and the path-traced reference with its path length
+// limited to the same number of bounces. Small images keep llvmpipe fast.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <fstream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "gi/rig.hpp"
+
+using namespace kiln;
+using namespace kiln::test;
+
+namespace {
+
+// The rasterized pipeline of pipelines/default.json with `bounces`, voxels at 32³.
+std::string rasterPipeline(int bounces) {
+    return pipeline("composite.color", R"(
+        {"id": "gbuffer", "module": "gbuffer"},
+        {"id": "shadow", "module": "shadow", "params": {"size": 256}},
+        {"id": "voxelize", "module": "voxelize", "inputs": {"shadow_map": "shadow.depth"}, "params": {"resolution": 32}},
+        {"id": "voxel_mip", "module": "voxel_mip",
+         "inputs": {"radiance": "voxelize.radiance", "albedo": "voxelize.albedo", "normal": "voxelize.normal"},
+         "params": {"mode": "fixed_cones", "bounces": )" + std::to_string(bounces) + R"(}},
+        {"id": "cone_trace", "module": "cone_trace",
+         "inputs": {"normal": "gbuffer.normal", "depth": "gbuffer.depth", "voxels": "voxel_mip.iso",
+                    "fixed_cones": "voxel_mip.fixed_cones"},
+         "params": {"trace_stride": 1}},
+        {"id": "composite", "module": "composite",
+         "inputs": {"albedo": "gbuffer.albedo", "normal": "gbuffer.normal", "depth": "gbuffer.depth",
+                    "emissive": "gbuffer.emissive", "shadow_map": "shadow.depth",
+                    "indirect": "cone_trace.indirect"},
+         "params": {"pcf": 3, "lamp_samples": 16}})");
+}
+
+// Mean Rec. 709 luminance over the pixels `keep` marks (all when empty).
+double meanLuminance(const FloatImage& img, const std::vector<bool>& keep = {}) {
+    double sum = 0.0;
+    int counted = 0;
+    for (int y = 0; y < img.height; ++y)
+        for (int x = 0; x < img.width; ++x) {
+            if (!keep.empty() && !keep[size_t(y) * img.width + x]) continue;
+            const float* c = img.at(x, y);
+            sum += 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+            ++counted;
+        }
+    return sum / std::max(counted, 1);
+}
+
+FloatImage rasterFrame(Rig& rig, int bounces) {
+    rig.load(rasterPipeline(bounces), {"composite.hdr", "gbuffer.emissive"});
+    rig.app.frame();
+    rig.checkNoErrors();
+    return rig.image("composite", "hdr");
+}
+
+// Pixels that show no emitter (their radiance is copied, not computed).
+std::vector<bool> notEmissive(Rig& rig) {
+    const FloatImage glow = rig.image("gbuffer", "emissive");
+    std::vector<bool> keep(size_t(glow.width) * glow.height);
+    for (int y = 0; y < glow.height; ++y)
+        for (int x = 0; x < glow.width; ++x) {
+            const float* e = glow.at(x, y);
+            keep[size_t(y) * glow.width + x] = e[0] + e[1] + e[2] == 0.0f;
+        }
+    return keep;
+}
+
+}  // namespace
+
+TEST_CASE("voxel_mip bounces: the white furnace — k bounces show 2 − 0.5^k of a closed box's radiance 2",
+          "[gi][bounces]") {
+    // Every surface has albedo 0.5 and emits 1 (the lamp too: colour 0.5 × intensity 2),
+    // the box is closed and the camera inside. Light that bounced i times arrives with
+    // 0.5^i, so a frame that shows k bounces (direct light and emission are bounce 0)
+    // has radiance Σ_{i≤k} 0.5^i = 2 − 0.5^k everywhere: 1.5, 1.75, 1.875, … → 2. The
+    // cone tracer's energy is the whole question: a cone that loses light through a
+    // wall or misses its weight shows up here, in every bounce. Measured within 0.41 %
+    // (k = 1) and 0.1 % (k = 2…4); the tolerance, 2 %, leaves room for another cone
+    // schedule and still fails a bounce that is missing (1.5 against 1.75) or a cone
+    // set that loses a twentieth of the light.
+    Rig rig(writeScene("furnace_bounces.json", R"({
+        "box": {"left": [0.5, 0.5, 0.5], "right": [0.5, 0.5, 0.5], "other": [0.5, 0.5, 0.5],
+                "floor_wood": {"light": [0.5, 0.5, 0.5], "dark": [0.5, 0.5, 0.5]},
+                "emission": [1, 1, 1], "closed": true},
+        "lamp": {"color": [0.5, 0.5, 0.5], "intensity": 2.0},
+        "tumblers": [], "marbles": [], "fireballs": []})"),
+            48);
+    rig.app.camera().distance = 0.5f;  // inside the box
+    double previous = 1.0;             // emission alone
+    for (int k = 1; k <= 4; ++k) {
+        const double mean = meanLuminance(rasterFrame(rig, k));
+        const double expected = 2.0 - std::pow(0.5, k);
+        INFO("bounces " << k << ": mean radiance " << mean << ", expected " << expected);
+        CHECK(std::abs(mean - expected) < 0.02 * expected);
+        // Each bounce adds light, and about half the last one's increment.
+        CHECK(mean > previous);
+        previous = mean;
+    }
+}
+
+TEST_CASE("voxel_mip bounces: each bounce adds what the path tracer's next path length adds", "[gi][bounces]") {
+    // The shipped scene at t = 0 without fireballs (no particles: the reference needs
+    // far more paths for their rare, bright samples), 24², emitters masked. The
+    // reference with max_bounces = k + 1 (path vertices: 1 = direct light only) holds
+    // exactly k bounces, as the raster frame with voxel_mip.bounces = k. Its mean over
+    // ~500 pixels × 256 paths has a standard deviation under 0.5 %.
+    // Measured (32³, 60° fixed cones): the frame is 0.969 / 1.040 / 1.091 of the
+    // reference for k = 1 / 2 / 3, and bounces 2 and 3 add 1.50× and 1.78× what the
+    // reference's do: the voxels' gather over-reflects (a surface sees part of itself
+    // through the coarse levels: a diameter offset of 1 instead of 0.5 brings it to
+    // 1.18× / 1.21×), the open issue this test pins. Asserted: every frame within 10 %,
+    // every bounce adds light, and each increment within a factor of 2 of the
+    // reference's (a bounce that is missing, doubled or reflected twice fails).
+    nlohmann::json scene = nlohmann::json::parse(std::ifstream(KILN_SOURCE_DIR "/scenes/cornell.json"));
+    scene["fireballs"] = nlohmann::json::array();
+    Rig rig(writeScene("still_bounces.json", scene.dump()), 24);
+    double previousRaster = 0.0, previousReference = 0.0;
+    for (int k = 1; k <= 3; ++k) {
+        const FloatImage frame = rasterFrame(rig, k);
+        const std::vector<bool> lit = notEmissive(rig);
+        rig.load(pipeline("reference.radiance", R"({"id": "reference", "module": "reference",
+                 "params": {"samples_per_frame": 64, "max_bounces": )" + std::to_string(k + 1) + "}}"));
+        for (int f = 0; f < 4; ++f) rig.app.frame();
+        rig.checkNoErrors();
+        const double reference = meanLuminance(rig.image("reference", "radiance"), lit);
+        const double raster = meanLuminance(frame, lit);
+        INFO("bounces " << k << ": raster " << raster << ", reference " << reference << " (ratio " << raster / reference
+                        << ")");
+        CHECK(std::abs(raster / reference - 1.0) < 0.10);
+        if (k > 1) {
+            const double addedRaster = raster - previousRaster, addedReference = reference - previousReference;
+            INFO("bounce " << k << " adds " << addedRaster << " (raster) against " << addedReference << " (reference)");
+            CHECK(addedReference > 0.0);
+            CHECK(addedRaster > 0.5 * addedReference);
+            CHECK(addedRaster < 2.0 * addedReference);
+        }
+        previousRaster = raster, previousReference = reference;
+    }
+}
