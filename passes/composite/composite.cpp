@@ -32,9 +32,14 @@ public:
                                   "shadow filter about k+1 texels wide from ((k+1)/2)² bilinear depth comparisons; 1 = one"))
             .param(floatParam("indirect_strength", 1.0f, 0.0, 8.0, "scales the bound indirect irradiance (1 = physical)"))
             .param(floatParam("shadow_bias", 0.0005f, 0.0, 0.05, "depth bias of the shadow test"))
-            .param(enumParam("lamp_model", "contour", {"contour", "points"},
+            .param(enumParam("lamp_model", "contour", {"contour", "points", "traced"},
                              "the lamp's irradiance: contour = its silhouette as a polygon (exact up to the "
-                             "polygon, also next to the dome); points = a quadrature over the cap (lobes near it)"))
+                             "polygon, also next to the dome); points = a quadrature over the cap (lobes near it); "
+                             "traced = the contour evaluated by cone_trace (its `lamp` on) where it traces, read "
+                             "from the indirect input's alpha"))
+            .param(floatParam("lamp_near_field", 0.2f, 0.0, 4.0,
+                              "lamp_model traced: within this many metres of the dome the contour is evaluated per "
+                              "pixel (the irradiance changes faster there than the traced samples)"))
             .param(intChoiceParam("lamp_samples", 32, {4, 8, 16, 32, 64},
                                   "vertices of the lamp's silhouette (contour) or quadrature points over its cap (points)"));
         d.reads = kSceneLight | kSceneCamera;
@@ -44,9 +49,13 @@ public:
     void execute(kiln::PassContext& ctx) override {
         GLuint program = ctx.program({.stages = {"common/fullscreen.vert", "composite/composite.frag"},
                                       .defines = {{"KILN_LAMP_SAMPLES", std::to_string(ctx.getInt("lamp_samples"))},
-                                                  {"KILN_LAMP_CONTOUR", ctx.getEnum("lamp_model") == "contour" ? "1" : "0"},
+                                                  {"KILN_LAMP_CONTOUR", ctx.getEnum("lamp_model") == "points" ? "0" : "1"},
+                                                  {"KILN_LAMP_TRACED", ctx.getEnum("lamp_model") == "traced" ? "1" : "0"},
                                                   {"KILN_PCF", std::to_string(ctx.getInt("pcf"))}}});
         if (!program) return;
+        if (ctx.getEnum("lamp_model") == "traced" && !ctx.isBound("indirect"))
+            return ctx.fail("lamp_model traced reads the lamp from `indirect` (cone_trace.indirect with cone_trace's "
+                            "`lamp` on): bind it, or use lamp_model contour");
         if (!ctx.framebuffer({"color", "hdr"})) return;
         glUseProgram(program);
         const char* inputs[] = {"albedo", "normal", "depth", "emissive", "shadow_map", "indirect", "bloom"};
@@ -71,6 +80,7 @@ public:
         glUniform1i(glGetUniformLocation(program, "u_tonemap"), tonemap == "aces" ? 0 : tonemap == "reinhard" ? 1 : 2);
         glUniform1f(glGetUniformLocation(program, "u_shadowBias"), ctx.getFloat("shadow_bias"));
         glUniform1f(glGetUniformLocation(program, "u_indirectStrength"), ctx.getFloat("indirect_strength"));
+        glUniform1f(glGetUniformLocation(program, "u_lampNearField"), ctx.getFloat("lamp_near_field"));
         ctx.drawFullscreenTriangle();
         glBindSampler(4, 0);
     }

@@ -129,7 +129,8 @@ public:
             .input({.name = "fixed_cones", .kind = TextureKind::Color3D, .required = false,
                     .doc = "voxel_mip.fixed_cones: trace the fixed cone set, one fetch per step (instead of aniso)"})
             .output({.name = "indirect", .format = Format::RGBA16F, .size = SizeRule::relativeOverParam("output_divisor"),
-                     .doc = "rgb = indirect irradiance / π, a = AO; the output's size ÷ output_divisor"})
+                     .doc = "rgb = indirect irradiance / π, a = AO (or with `lamp`: the lamp's projected solid "
+                            "angle); the output's size ÷ output_divisor"})
             .internal({.name = "samples", .format = Format::RGBA16F, .size = SizeRule::relativeOverParam("trace_stride"),
                        .doc = "trace_stride > 1: the traced samples"})
             .internal({.name = "planes", .format = Format::RGBA16F, .size = SizeRule::relativeOverParam("trace_stride"),
@@ -148,8 +149,12 @@ public:
                                   "trace one pixel per N×N block and upsample (depth/normal aware); 1 = every pixel"))
             .param(intChoiceParam("output_divisor", 1, {1, 2},
                                   "2: upsample to half resolution; composite's bilinear lookup does the last 2×"))
-            .param(floatParam("upsample_tolerance", 0.02f, 0.001, 1.0, "plane distance (world) that halves a sample's weight"));
-        d.reads = kSceneCamera;
+            .param(floatParam("upsample_tolerance", 0.02f, 0.001, 1.0, "plane distance (world) that halves a sample's weight"))
+            .param(boolParam("lamp", false,
+                             "alpha = the lamp's unshadowed projected solid angle at each traced surface (its "
+                             "silhouette's contour, 16 vertices), upsampled with the indirect light, for composite's "
+                             "lamp_model traced; off: alpha = ambient visibility"));
+        d.reads = kSceneCamera | kSceneLight;
         return d;
     }
 
@@ -161,8 +166,10 @@ public:
                             ": the fixed set traces 6 cones a pixel (4 on axis-aligned walls); set 6, or bind "
                             "`aniso` instead of `fixed_cones` for other counts");
         const kiln::TextureRef& voxels = ctx.input("voxels");
-        GLuint trace = ctx.program({.stages = {"common/fullscreen.vert", "cone_trace/cone_trace.frag"},
-                                    .defines = schedule(ctx, voxels.width)});
+        kiln::Defines defines = schedule(ctx, voxels.width);
+        defines.emplace_back("KILN_LAMP_IN_ALPHA", ctx.getBool("lamp") ? "1" : "0");
+        defines.emplace_back("KILN_LAMP_SAMPLES", "16");  // silhouette vertices: within 0.8 % (tests/gi/test_lamp.cpp)
+        GLuint trace = ctx.program({.stages = {"common/fullscreen.vert", "cone_trace/cone_trace.frag"}, .defines = defines});
         GLuint upsample = ctx.program({.stages = {"common/fullscreen.vert", "cone_trace/upsample.frag"}});
         if (!trace || !upsample) return;
         const int stride = ctx.getInt("trace_stride");

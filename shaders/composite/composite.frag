@@ -25,6 +25,7 @@ uniform float u_gamma;
 uniform int u_tonemap;   // kTonemapAces, kTonemapReinhard, kTonemapClamp
 uniform float u_shadowBias;
 uniform float u_indirectStrength;
+uniform float u_lampNearField;  // lamp_model traced: metres from the dome evaluated per pixel
 
 // Fraction of the lamp that sees p: a k×k percentage-closer filter over the shadow
 // map (k = KILN_PCF; 1 is one bilinear test). No map bound: everything is lit.
@@ -53,7 +54,18 @@ void main() {
         vec3 albedo = texelFetch(u_albedo, px, 0).rgb;
         vec3 p = worldPosition(v_uv, texelFetch(u_depth, px, 0).r);
         vec3 n = normalize(n4.xyz);
+#if KILN_LAMP_TRACED
+        // cone_trace's `lamp`: the projected solid angle where it traced, upsampled. Within
+        // u_lampNearField of the dome it changes faster than those samples: evaluated
+        // here. A loop that runs once or not at all, because llvmpipe leaves a loop when
+        // no lane has work but runs an `if` body for every lane.
+        float solidAngle = texture(u_indirect, v_uv).a;
+        for (int near = distance(p, u_lightPos.xyz) < u_lightPos.w + u_lampNearField ? 1 : 0; near > 0; --near)
+            solidAngle = lampProjectedSolidAngle(p, n);
+        vec3 irradiance = u_lightColor.rgb * solidAngle;
+#else
         vec3 irradiance = lampLight(p, n);
+#endif
         float visible = max(irradiance.r, max(irradiance.g, irradiance.b)) > 0.0 ? lightVisibility(p + n * 0.004) : 0.0;
         vec3 direct = albedo / 3.14159265 * irradiance * visible;
         vec3 indirect = albedo * u_indirectStrength * texture(u_indirect, v_uv).rgb;
