@@ -7,10 +7,12 @@
 //                      [--sweep PASS.PARAM=V1,V2,...]... [--cartesian] [--out DIR] [--cache DIR]
 //
 // 1. Steps the scene to --time and freezes it.
-// 2. The reference (passes/reference) at --spp paths per pixel, cached as OpenEXR in
-//    --cache (default: DIR/cache/) under a hash of the scene file, the simulation's
-//    state at --time, the size, the sample count and the reference pass's code
-//    (progress and ETA on stderr while it renders).
+// 2. The reference (passes/reference) at --spp paths per pixel, rendered as two
+//    independent halves A and B of --spp/2 paths (seeds 1 and 2), each cached as
+//    OpenEXR in --cache (default: DIR/cache/) under a hash of the scene file, the
+//    simulation's state at --time, the size, the half's path count, its seed and the
+//    reference pass's code (progress and ETA on stderr while it renders). The
+//    reference is their mean R = (A + B)/2, the same --spp paths as one render.
 // 3. The pipeline once as it is ("default"), each --also pipeline as it is (labelled by
 //    its file name, e.g. pipelines/seed.json: before and after in one run), and once
 //    per value of each --sweep (one
@@ -25,9 +27,24 @@
 //    alone (total − direct: the setting run again with composite.indirect_strength 0,
 //    the reference's own `direct` output) and per region of the box (floor, walls,
 //    ceiling, objects; from the G-buffer depth's world position).
-// 4. Marks the Pareto front over (total GPU ms, relative MSE): settings no other
-//    setting beats on both; plots every setting, the front and the default
-//    (DIR/quality.png, log-log).
+// 4. Bias apart from noise. An error against a path-traced reference includes the
+//    reference's own noise: at a few hundred paths relative MSE and SSIM largely
+//    measure R, not the setting, and every setting looks about as good. The halves
+//    give that noise per pixel, (A − B)²/4 (metrics.hpp), hence:
+//    - the reference's noise floor: the relative MSE R has against the truth, on
+//      expectation (header; also for the indirect part);
+//    - noise-corrected relative MSE, total and indirect: the raw figure less that
+//      noise pixel by pixel, an estimate of the error against the converged truth
+//      (slightly negative for a setting closer to the truth than R can tell);
+//    - bias per region (all, floor, walls, ceiling, objects), total and indirect: mean
+//      luminance of the setting ÷ that of R, ± one standard deviation of R's noise;
+//    - SSIM only where it means something: the halves' SSIM against each other is
+//      printed; below 0.97 the reference's noise would dominate the structure SSIM
+//      sees, so the settings' SSIM is withheld (n/a; empty in the CSV).
+// 5. Marks the Pareto front over (total GPU ms, noise-corrected relative MSE): settings
+//    no other setting beats on both; plots every setting, the front and the default
+//    (DIR/quality.png, log-log: settings at or below 0 are left off). Writes
+//    DIR/quality.csv (one row per setting) and DIR/summary.json (the header's figures).
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -117,8 +134,10 @@ Args parseArgs(int argc, char** argv) {
             if (std::sscanf(v.c_str(), "%dx%d", &args.width, &args.height) != 2 || args.width < 8 || args.height < 8 ||
                 args.width > 4096 || args.height > 4096)
                 usageError("--size " + v + ": expected WxH between 8 and 4096");
-        } else if (a == "--spp") args.spp = positive(next());
-        else if (a == "--frames") args.frames = positive(next());
+        } else if (a == "--spp") {
+            args.spp = positive(next());
+            if (args.spp % 2) usageError("--spp " + std::to_string(args.spp) + ": expected an even count (two halves of N/2 paths)");
+        } else if (a == "--frames") args.frames = positive(next());
         else if (a == "--repeats") args.repeats = positive(next());
         else if (a == "--cartesian") args.cartesian = true;
         else if (a == "--sweep") args.sweeps.push_back(next());
@@ -182,15 +201,30 @@ bool fail(const std::string& message) {
     return false;
 }
 
-// The reference radiance, from the cache or rendered now.
-// The cache key covers everything the reference image depends on: the scene file (looks,
-// lamp), the simulation's state at --time (so a change to the simulation's code is a new
-// reference), the size and sample count, and the reference pass's code: its shaders,
-// the shared ones it includes and its module's source.
-bool reference(app::App& app, const Args& args, FloatImage& out, FloatImage& direct) {
+// The reference is rendered as two halves with these seeds (independent random
+// sequences: the path tracer hashes the seed into every pixel's stream).
+constexpr int kHalfSeeds[2] = {1, 2};
+// The halves' SSIM against each other below which the settings' SSIM is withheld.
+constexpr double kSsimMeaningful = 0.97;
+
+// The reference as two independent halves and their mean; each also as its indirect
+// part (radiance − direct), which is what the indirect figures compare.
+struct Reference {
+    FloatImage halves[2], halvesIndirect[2];
+    FloatImage mean, meanIndirect;  // R = (A + B)/2: what the errors are measured against
+    double renderSeconds = 0;       // rendering this run (0: both from the cache)
+};
+
+// One half of the reference (radiance and direct), from the cache or rendered now.
+// The cache key covers everything the image depends on: the scene file (looks, lamp),
+// the simulation's state at --time (so a change to the simulation's code is a new
+// reference), the size, the half's path count and seed, and the reference pass's code:
+// its shaders, the shared ones it includes and its module's source.
+bool referenceHalf(app::App& app, const Args& args, int half, FloatImage& out, FloatImage& direct, double& seconds) {
+    const int seed = kHalfSeeds[half], paths = args.spp / 2;
     const std::string sceneText = slurp(args.scene);
     uint64_t key = fnv1a(sceneText);
-    const double values[] = {args.time, double(args.width), double(args.height), double(args.spp)};
+    const double values[] = {args.time, double(args.width), double(args.height), double(paths), double(seed)};
     key = fnv1a(values, sizeof values, key);
     const uint64_t simState = app.scene().sim().stateHash();
     key = fnv1a(&simState, sizeof simState, key);
@@ -200,30 +234,33 @@ bool reference(app::App& app, const Args& args, FloatImage& out, FloatImage& dir
         for (const auto& entry : fs::directory_iterator(source / dir)) code.push_back(entry.path());
     std::sort(code.begin(), code.end());
     for (const fs::path& file : code) key = fnv1a(slurp(file.string()), key);
-    char name[64];
-    std::snprintf(name, sizeof name, "reference-%016llx.exr", static_cast<unsigned long long>(key));
+    char name[80];
+    std::snprintf(name, sizeof name, "reference-%016llx-seed%d.exr", static_cast<unsigned long long>(key), seed);
     const fs::path cache = (args.cacheDir.empty() ? fs::path(args.outDir) / "cache" : fs::path(args.cacheDir)) / name;
     fs::path directCache = cache;
     directCache.replace_extension(".direct.exr");
+    char what[64];
+    std::snprintf(what, sizeof what, "reference half %c (seed %d)", "AB"[half], seed);
     std::string error;
     if (fs::exists(cache) && fs::exists(directCache) && readExr(cache.string(), out, error) &&
         readExr(directCache.string(), direct, error)) {
-        std::printf("reference: %s (cached)\n", cache.string().c_str());
+        std::printf("%s: %s (cached)\n", what, cache.string().c_str());
         return true;
     }
-    const int perFrame = std::min(args.spp, 16);
+    const int perFrame = std::min(paths, 16);
     const std::string text = R"({"output": "reference.radiance", "passes": [{"id": "reference", "module": "reference",
-        "params": {"samples_per_frame": )" + std::to_string(perFrame) + R"(, "max_samples": )" + std::to_string(args.spp) + "}}]}";
+        "params": {"samples_per_frame": )" + std::to_string(perFrame) + R"(, "max_samples": )" + std::to_string(paths) +
+                             R"(, "seed": )" + std::to_string(seed) + "}}]}";
     if (!app.runtime().loadPipelineText(text, "reference", error)) return fail(error);
     const auto start = std::chrono::steady_clock::now();
-    for (int done = 0; done < args.spp; done += perFrame) {
+    for (int done = 0; done < paths; done += perFrame) {
         app.frame();
         glFinish();
         const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        const int now = std::min(done + perFrame, args.spp);
-        const int bar = 30 * now / args.spp;
-        std::fprintf(stderr, "\rreference %dx%d [%-30s] %d/%d paths/px, %.0f s, ETA %.0f s ", args.width, args.height,
-                     std::string(size_t(bar), '#').c_str(), now, args.spp, elapsed, elapsed / now * (args.spp - now));
+        const int now = std::min(done + perFrame, paths);
+        const int bar = 30 * now / paths;
+        std::fprintf(stderr, "\r%s %dx%d [%-30s] %d/%d paths/px, %.0f s, ETA %.0f s ", what, args.width, args.height,
+                     std::string(size_t(bar), '#').c_str(), now, paths, elapsed, elapsed / now * (paths - now));
     }
     std::fprintf(stderr, "\n");
     const TextureRef* t = app.runtime().findTexture("reference", "radiance");
@@ -232,11 +269,24 @@ bool reference(app::App& app, const Args& args, FloatImage& out, FloatImage& dir
     const TextureRef* d = app.runtime().findTexture("reference", "direct");
     if (!d) return fail("the reference pass produced no direct texture");
     direct = readTexture(d->id, d->target, d->format, d->width, d->height);
-    if (out.at(0, 0)[3] != float(args.spp)) return fail("the reference stopped early: " + std::to_string(out.at(0, 0)[3]) + " paths");
+    if (out.at(0, 0)[3] != float(paths)) return fail("the reference stopped early: " + std::to_string(out.at(0, 0)[3]) + " paths");
     fs::create_directories(cache.parent_path());
     if (!writeExr(cache.string(), out, error) || !writeExr(directCache.string(), direct, error)) return fail(error);
-    std::printf("reference: %d paths/px in %.1f s, cached as %s\n", args.spp,
-                std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), cache.string().c_str());
+    seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::printf("%s: %d paths/px in %.1f s, cached as %s\n", what, paths, seconds, cache.string().c_str());
+    return true;
+}
+
+bool loadReference(app::App& app, const Args& args, Reference& ref) {
+    FloatImage directs[2];
+    for (int half = 0; half < 2; ++half) {
+        double seconds = 0;
+        if (!referenceHalf(app, args, half, ref.halves[half], directs[half], seconds)) return false;
+        ref.renderSeconds += seconds;
+        ref.halvesIndirect[half] = metrics::difference(ref.halves[half], directs[half]);
+    }
+    ref.mean = metrics::average(ref.halves[0], ref.halves[1]);
+    ref.meanIndirect = metrics::average(ref.halvesIndirect[0], ref.halvesIndirect[1]);
     return true;
 }
 
@@ -265,18 +315,26 @@ std::vector<int> regionsOf(const app::App& app, const FloatImage& depth) {
     return region;
 }
 
+// The bias figures look at the whole counted image and at each region in turn.
+constexpr int kPartCount = kRegionCount + 1;  // [0] all, [1 + region]
+const char* const kPartNames[kPartCount] = {"all", "floor", "walls", "ceiling", "objects"};
+
 struct Result {
     std::string label;
     std::vector<std::pair<std::string, double>> passMs;  // plan order
     double totalMs = 0;
-    metrics::Errors errors;
+    metrics::Errors errors;  // against R
     double indirectRelMse = 0;
     double regionRelMse[kRegionCount] = {};
+    // Less the reference's own noise: estimates of the error against the truth.
+    double relMseCorrected = 0, indirectRelMseCorrected = 0;
+    // Mean luminance of the setting ÷ that of R, total and indirect, per part.
+    metrics::RatioWithUncertainty meanRatio[kPartCount], indirectRatio[kPartCount];
+    metrics::Mask counted;  // the pixels the figures count (emitters out)
     bool pareto = false;
 };
 
-bool measure(app::App& app, const Args& args, const Setting& setting, const FloatImage& ref, const FloatImage& refDirect,
-             Result& r) {
+bool measure(app::App& app, const Args& args, const Setting& setting, const Reference& ref, Result& r) {
     std::string text, error;
     const std::string& pipeline = setting.pipeline.empty() ? args.pipeline : setting.pipeline;
     if (!applyOverrides(slurp(pipeline), setting.overrides, text, error) ||
@@ -308,40 +366,69 @@ bool measure(app::App& app, const Args& args, const Setting& setting, const Floa
             const float* e = glow.at(x, y);
             if (e[0] + e[1] + e[2] > 0.0f) mask[size_t(y) * image.width + x] = 0;
         }
-    r.errors = metrics::compare(image, ref, mask);
+    const FloatImage& halfA = ref.halves[0];
+    const FloatImage& halfB = ref.halves[1];
+    r.errors = metrics::compare(image, ref.mean, mask);
+    r.relMseCorrected = metrics::noiseCorrectedRelativeMse(image, halfA, halfB, mask);
 
     const TextureRef* depth = app.runtime().findTexture("gbuffer", "depth");
     if (!depth) return fail(setting.label + ": the pipeline has no gbuffer.depth");
     const std::vector<int> region = regionsOf(app, readTexture(depth->id, depth->target, depth->format, depth->width, depth->height));
+    std::vector<metrics::Mask> partMask(kPartCount, mask);
     for (int k = 0; k < kRegionCount; ++k) {
-        metrics::Mask m = mask;
+        metrics::Mask& m = partMask[1 + k];
         for (size_t i = 0; i < m.size(); ++i) m[i] = m[i] && region[i] == k;
-        r.regionRelMse[k] = metrics::relativeMse(image, ref, m);
+        r.regionRelMse[k] = metrics::relativeMse(image, ref.mean, m);
     }
+    for (int p = 0; p < kPartCount; ++p) r.meanRatio[p] = metrics::meanLuminanceRatio(image, halfA, halfB, partMask[p]);
     // The indirect part: the same frame without composite's indirect term.
     if (!app.runtime().setParam("composite", "indirect_strength", 0.0f, error)) return fail(setting.label + ": " + error);
     app.frame();
     glFinish();
-    const FloatImage direct = readTexture(hdr->id, hdr->target, hdr->format, hdr->width, hdr->height);
-    r.indirectRelMse = metrics::relativeMse(metrics::difference(image, direct), metrics::difference(ref, refDirect), mask);
-    return std::isfinite(r.errors.rmse) && std::isfinite(r.errors.relMse) && std::isfinite(r.errors.ssim)
-               ? true
-               : fail(setting.label + ": an error metric is not finite");
+    const FloatImage indirect = metrics::difference(image, readTexture(hdr->id, hdr->target, hdr->format, hdr->width, hdr->height));
+    const FloatImage& indirectA = ref.halvesIndirect[0];
+    const FloatImage& indirectB = ref.halvesIndirect[1];
+    r.indirectRelMse = metrics::relativeMse(indirect, ref.meanIndirect, mask);
+    r.indirectRelMseCorrected = metrics::noiseCorrectedRelativeMse(indirect, indirectA, indirectB, mask);
+    for (int p = 0; p < kPartCount; ++p)
+        r.indirectRatio[p] = metrics::meanLuminanceRatio(indirect, indirectA, indirectB, partMask[p]);
+    r.counted = std::move(mask);
+    // The ratios may be NaN (a region out of view): they are printed as n/a, not checked.
+    for (double v : {r.errors.rmse, r.errors.relMse, r.errors.ssim, r.relMseCorrected, r.indirectRelMse, r.indirectRelMseCorrected})
+        if (!std::isfinite(v)) return fail(setting.label + ": an error metric is not finite");
+    return true;
 }
 
 void markPareto(std::vector<Result>& results) {
     for (auto& a : results) {
         a.pareto = true;
         for (auto& b : results)
-            if (&a != &b && b.totalMs <= a.totalMs && b.errors.relMse <= a.errors.relMse &&
-                (b.totalMs < a.totalMs || b.errors.relMse < a.errors.relMse))
+            if (&a != &b && b.totalMs <= a.totalMs && b.relMseCorrected <= a.relMseCorrected &&
+                (b.totalMs < a.totalMs || b.relMseCorrected < a.relMseCorrected))
                 a.pareto = false;
     }
+}
+
+// A ratio and its uncertainty in 12 columns ("1.023±0.004"), or n/a (a part out of view).
+std::string ratioCell(const metrics::RatioWithUncertainty& r) {
+    char cell[48];
+    if (std::isfinite(r.ratio)) std::snprintf(cell, sizeof cell, "%6.3f±%5.3f", r.ratio, r.uncertainty);
+    else std::snprintf(cell, sizeof cell, "%12s", "n/a");
+    return cell;
+}
+
+// A CSV cell: empty where there is no value (NaN), so a reader sees a gap, not "nan".
+std::string csvNumber(double v) {
+    if (!std::isfinite(v)) return "";
+    std::ostringstream s;
+    s << v;
+    return s.str();
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
+    const auto started = std::chrono::steady_clock::now();
     const Args args = parseArgs(argc, argv);
     const std::vector<Setting> settings = settingsOf(args);
     std::string error;
@@ -361,12 +448,13 @@ int main(int argc, char** argv) {
     if (!app.init(o, error)) return fail(error) ? 0 : 1;
     while (app.scene().time() + 1e-9 < args.time) app.frame();  // to the chosen moment
     app.paused = true;
-    std::printf("device: %s\nscene %s frozen at t = %.3f s, %dx%d, reference %d paths/px, %d timed frames x %d rounds\n\n",
+    std::printf("device: %s\nscene %s frozen at t = %.3f s, %dx%d, reference %d paths/px (two halves of %d, seeds %d and %d), "
+                "%d timed frames x %d rounds\n\n",
                 context->description().c_str(), args.scene.c_str(), app.scene().time(), args.width, args.height,
-                args.spp, args.frames, args.repeats);
+                args.spp, args.spp / 2, kHalfSeeds[0], kHalfSeeds[1], args.frames, args.repeats);
 
-    FloatImage ref, refDirect;
-    if (!reference(app, args, ref, refDirect)) return 1;
+    Reference ref;
+    if (!loadReference(app, args, ref)) return 1;
     // Errors are deterministic (one round gives them); times are medians over the rounds.
     std::vector<Result> results(settings.size());
     std::vector<std::map<std::string, std::vector<double>>> passSamples(settings.size());
@@ -374,7 +462,7 @@ int main(int argc, char** argv) {
     for (int round = 0; round < args.repeats; ++round)
         for (size_t i = 0; i < settings.size(); ++i) {
             Result r;
-            if (!measure(app, args, settings[i], ref, refDirect, r)) return 1;
+            if (!measure(app, args, settings[i], ref, r)) return 1;
             totals[i].push_back(r.totalMs);
             for (auto& [id, ms] : r.passMs) passSamples[i][id].push_back(ms);
             if (round == 0) results[i] = std::move(r);
@@ -385,47 +473,121 @@ int main(int argc, char** argv) {
     }
     markPareto(results);
 
+    // The reference's own figures, over the pixels the first setting counts (every
+    // pipeline draws the same scene from the same camera, so the emitters are the same).
+    const metrics::Mask& counted = results.front().counted;
+    const double halvesSsim = metrics::ssim(metrics::displayLuminance(ref.halves[0]), metrics::displayLuminance(ref.halves[1]),
+                                            args.width, args.height, counted);
+    const bool ssimMeaningful = halvesSsim >= kSsimMeaningful;
+    const double noiseFloor = metrics::referenceNoiseRelativeMse(ref.halves[0], ref.halves[1], counted);
+    const double noiseFloorIndirect = metrics::referenceNoiseRelativeMse(ref.halvesIndirect[0], ref.halvesIndirect[1], counted);
+    std::printf("\nreference noise floor: relMSE %.5f, indirect %.5f (R's own error against the truth, on expectation;\n"
+                "  the \"corrected\" columns subtract it pixel by pixel: estimates of the error against the truth)\n",
+                noiseFloor, noiseFloorIndirect);
+    std::printf("reference halves: SSIM(A, B) = %.4f (display luminance, emitters masked)\n", halvesSsim);
+    if (!ssimMeaningful)
+        std::printf("SSIM withheld: the reference's halves score %.4f against each other (< %.2f); more --spp\n", halvesSsim,
+                    kSsimMeaningful);
+    std::printf("\n");
+
     fs::create_directories(args.outDir);
     const std::string csvPath = (fs::path(args.outDir) / "quality.csv").string();
     std::ofstream csv(csvPath);
     csv << "setting,total_gpu_ms,rmse,rel_mse,ssim,psnr,pixels,pareto,rel_mse_indirect";
     for (const char* name : kRegionNames) csv << ",rel_mse_" << name;
+    csv << ",rel_mse_corrected,rel_mse_indirect_corrected";
+    for (const char* kind : {"mean_ratio_", "indirect_ratio_"})
+        for (const char* part : kPartNames) csv << ',' << kind << part << ',' << kind << part << "_uncertainty";
     csv << ",pass_ms\n";
-    std::printf("%-44s %9s %9s %9s %7s %7s %9s  %-31s %s\n", "setting", "gpu ms", "RMSE", "relMSE", "SSIM", "PSNR",
-                "indirect", "relMSE floor/walls/ceil/objects", "front");
+    std::printf("%-44s %9s %9s %9s %9s %7s %7s %9s %9s  %-31s %s\n", "setting", "gpu ms", "RMSE", "relMSE", "corrected",
+                "SSIM", "PSNR", "indirect", "corrected", "relMSE floor/walls/ceil/objects", "front");
     for (auto& r : results) {
-        std::printf("%-44s %9.2f %9.5f %9.5f %7.4f %7.2f %9.5f  %7.4f %7.4f %7.4f %7.4f  %s\n", r.label.c_str(), r.totalMs,
-                    r.errors.rmse, r.errors.relMse, r.errors.ssim, r.errors.psnr, r.indirectRelMse, r.regionRelMse[0],
-                    r.regionRelMse[1], r.regionRelMse[2], r.regionRelMse[3], r.pareto ? "*" : "");
+        char ssimCell[16] = "n/a";
+        if (ssimMeaningful) std::snprintf(ssimCell, sizeof ssimCell, "%.4f", r.errors.ssim);
+        std::printf("%-44s %9.2f %9.5f %9.5f %9.5f %7s %7.2f %9.5f %9.5f  %7.4f %7.4f %7.4f %7.4f  %s\n", r.label.c_str(),
+                    r.totalMs, r.errors.rmse, r.errors.relMse, r.relMseCorrected, ssimCell, r.errors.psnr, r.indirectRelMse,
+                    r.indirectRelMseCorrected, r.regionRelMse[0], r.regionRelMse[1], r.regionRelMse[2], r.regionRelMse[3],
+                    r.pareto ? "*" : "");
         std::string passes;
         for (auto& [id, ms] : r.passMs) passes += (passes.empty() ? "" : " ") + id + "=" + std::to_string(ms);
         csv << '"' << r.label << "\"," << r.totalMs << ',' << r.errors.rmse << ',' << r.errors.relMse << ','
-            << r.errors.ssim << ',' << r.errors.psnr << ',' << r.errors.pixels << ',' << (r.pareto ? 1 : 0) << ','
-            << r.indirectRelMse;
+            << (ssimMeaningful ? csvNumber(r.errors.ssim) : "") << ',' << r.errors.psnr << ',' << r.errors.pixels << ','
+            << (r.pareto ? 1 : 0) << ',' << r.indirectRelMse;
         for (double v : r.regionRelMse) csv << ',' << v;
+        csv << ',' << r.relMseCorrected << ',' << r.indirectRelMseCorrected;
+        for (const auto* ratios : {r.meanRatio, r.indirectRatio})
+            for (int p = 0; p < kPartCount; ++p)
+                csv << ',' << csvNumber(ratios[p].ratio) << ',' << csvNumber(ratios[p].uncertainty);
         csv << ",\"" << passes << "\"\n";
     }
+    std::printf("\n* = on the Pareto front of (GPU ms, corrected relMSE); corrected = less the reference's own noise\n\n");
+
+    std::printf("bias: mean luminance of the setting ÷ the reference's, ± 1σ of the reference's noise\n");
+    std::printf("%-44s  %-65s %s\n%-44s", "", "total", "indirect", "setting");
+    for (int kind = 0; kind < 2; ++kind) {
+        std::printf(" ");
+        for (const char* part : kPartNames) std::printf(" %12s", part);
+    }
+    std::printf("\n");
+    for (auto& r : results) {
+        std::printf("%-44s", r.label.c_str());
+        for (const auto* ratios : {r.meanRatio, r.indirectRatio}) {
+            std::printf(" ");
+            for (int p = 0; p < kPartCount; ++p) std::printf(" %s", ratioCell(ratios[p]).c_str());
+        }
+        std::printf("\n");
+    }
+
     LogLogPlot plot{"GPU ms against error vs the reference", "total GPU ms per frame",
-                    "relative MSE (emitters masked)", {}};
+                    "relative MSE, noise-corrected (less the reference's own; emitters masked)", {}};
     PlotSeries all{"settings", {150, 150, 150}, {}, false, 3}, front{"Pareto front", {200, 40, 40}, {}, true, 4},
         defaults{"default", {30, 90, 220}, {}, false, 7};
     std::vector<const Result*> onFront;
     std::vector<PlotSeries> others;  // one highlighted point per --also pipeline
+    std::string offThePlot;          // log axes: a corrected relMSE ≤ 0 has no place on them
     const std::array<uint8_t, 3> otherColors[] = {{230, 140, 20}, {40, 160, 70}, {140, 60, 170}};
     for (auto& r : results) {
-        all.points.emplace_back(r.totalMs, r.errors.relMse);
+        all.points.emplace_back(r.totalMs, r.relMseCorrected);
+        if (r.relMseCorrected <= 0.0) offThePlot += (offThePlot.empty() ? "" : ", ") + r.label;
         if (r.pareto) onFront.push_back(&r);
-        if (r.label == "default") defaults.points.emplace_back(r.totalMs, r.errors.relMse);
+        if (r.label == "default") defaults.points.emplace_back(r.totalMs, r.relMseCorrected);
         for (size_t i = 0; i < args.also.size(); ++i)
             if (r.label == fs::path(args.also[i]).stem().string())
-                others.push_back({r.label, otherColors[i % 3], {{r.totalMs, r.errors.relMse}}, false, 7});
+                others.push_back({r.label, otherColors[i % 3], {{r.totalMs, r.relMseCorrected}}, false, 7});
     }
     std::sort(onFront.begin(), onFront.end(), [](auto* a, auto* b) { return a->totalMs < b->totalMs; });
-    for (auto* r : onFront) front.points.emplace_back(r->totalMs, r->errors.relMse);
+    for (auto* r : onFront) front.points.emplace_back(r->totalMs, r->relMseCorrected);
     plot.series = {all, front, defaults};
     plot.series.insert(plot.series.end(), others.begin(), others.end());
     const std::string pngPath = (fs::path(args.outDir) / "quality.png").string();
     if (!writeLogLogPng(pngPath, plot, error)) return fail(error) ? 0 : 1;
-    std::printf("\n* = on the Pareto front of (GPU ms, relative MSE)\nwrote %s and %s\n", csvPath.c_str(), pngPath.c_str());
+    if (!offThePlot.empty())
+        std::printf("\nnot on the plot (corrected relMSE <= 0: within the reference's noise): %s\n", offThePlot.c_str());
+
+    // null where a figure has no value (nlohmann writes NaN as null).
+    const nlohmann::json summary = {
+        {"device", context->description()},
+        {"scene", args.scene},
+        {"scene_time_s", app.scene().time()},
+        {"width", args.width},
+        {"height", args.height},
+        {"spp", args.spp},
+        {"spp_per_half", args.spp / 2},
+        {"seeds", {kHalfSeeds[0], kHalfSeeds[1]}},
+        {"pixels", results.front().errors.pixels},
+        {"ssim_halves", halvesSsim},
+        {"ssim_threshold", kSsimMeaningful},
+        {"ssim_reported", ssimMeaningful},
+        {"ref_noise_rel_mse", noiseFloor},
+        {"ref_noise_rel_mse_indirect", noiseFloorIndirect},
+        {"reference_render_s", ref.renderSeconds},
+        {"wall_s", std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count()},
+        {"frames", args.frames},
+        {"repeats", args.repeats},
+        {"settings", results.size()},
+    };
+    const std::string summaryPath = (fs::path(args.outDir) / "summary.json").string();
+    std::ofstream(summaryPath) << summary.dump(2) << '\n';
+    std::printf("wrote %s, %s and %s\n", csvPath.c_str(), pngPath.c_str(), summaryPath.c_str());
     return 0;
 }

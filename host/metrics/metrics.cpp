@@ -34,6 +34,23 @@ double meanOver(const FloatImage& a, const FloatImage& b, const Mask& mask, F f)
     return n ? sum / double(n) : 0.0;
 }
 
+// Mean over counted pixels and the RGB channels of f(k, a, b), one value of each image.
+template <class F>
+double meanOver3(const FloatImage& k, const FloatImage& a, const FloatImage& b, const Mask& mask, F f) {
+    checkShapes(k, a, mask);
+    checkShapes(a, b, mask);
+    double sum = 0.0;
+    size_t n = 0;
+    for (int y = 0; y < a.height; ++y)
+        for (int x = 0; x < a.width; ++x) {
+            if (!counted(mask, size_t(y) * a.width + x)) continue;
+            for (int c = 0; c < 3; ++c)
+                sum += f(double(k.at(x, y)[c]), double(a.at(x, y)[c]), double(b.at(x, y)[c]));
+            n += 3;
+        }
+    return n ? sum / double(n) : 0.0;
+}
+
 double aces(double x) {
     x = std::max(x, 0.0);
     return std::clamp((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14), 0.0, 1.0);
@@ -110,6 +127,69 @@ FloatImage difference(const FloatImage& a, const FloatImage& b) {
         for (int x = 0; x < a.width; ++x)
             for (int c = 0; c < std::min(3, a.channels); ++c) d.at(x, y)[c] = a.at(x, y)[c] - b.at(x, y)[c];
     return d;
+}
+
+FloatImage average(const FloatImage& a, const FloatImage& b) {
+    checkShapes(a, b, {});
+    if (a.channels != b.channels) throw std::invalid_argument("metrics: images differ in channel count");
+    FloatImage mean = a;
+    for (size_t i = 0; i < mean.pixels.size(); ++i) mean.pixels[i] = 0.5f * (a.pixels[i] + b.pixels[i]);
+    return mean;
+}
+
+double referenceNoiseRelativeMse(const FloatImage& halfA, const FloatImage& halfB, const Mask& mask, double epsilon) {
+    return meanOver(halfA, halfB, mask, [epsilon](double a, double b) {
+        const double r = 0.5 * (a + b);
+        return 0.25 * (a - b) * (a - b) / (r * r + epsilon);
+    });
+}
+
+double noiseCorrectedRelativeMse(const FloatImage& image, const FloatImage& halfA, const FloatImage& halfB,
+                                 const Mask& mask, double epsilon) {
+    return meanOver3(image, halfA, halfB, mask, [epsilon](double k, double a, double b) {
+        const double r = 0.5 * (a + b);
+        return ((k - r) * (k - r) - 0.25 * (a - b) * (a - b)) / (r * r + epsilon);
+    });
+}
+
+double meanLuminance(const FloatImage& radiance, const Mask& mask) {
+    checkShapes(radiance, radiance, mask);
+    double sum = 0.0;
+    size_t n = 0;
+    for (int y = 0; y < radiance.height; ++y)
+        for (int x = 0; x < radiance.width; ++x)
+            if (counted(mask, size_t(y) * radiance.width + x)) sum += luminance(radiance.at(x, y)), ++n;
+    return n ? sum / double(n) : 0.0;
+}
+
+double meanLuminanceRatio(const FloatImage& image, const FloatImage& reference, const Mask& mask) {
+    checkShapes(image, reference, mask);
+    const double denominator = meanLuminance(reference, mask);
+    return denominator > 0.0 ? meanLuminance(image, mask) / denominator : NAN;
+}
+
+RatioWithUncertainty meanLuminanceRatio(const FloatImage& image, const FloatImage& halfA, const FloatImage& halfB,
+                                        const Mask& mask) {
+    checkShapes(image, halfA, mask);
+    checkShapes(halfA, halfB, mask);
+    double sumImage = 0.0, sumReference = 0.0, sumVariance = 0.0;
+    size_t n = 0;
+    for (int y = 0; y < image.height; ++y)
+        for (int x = 0; x < image.width; ++x) {
+            if (!counted(mask, size_t(y) * image.width + x)) continue;
+            const double a = luminance(halfA.at(x, y)), b = luminance(halfB.at(x, y));
+            sumImage += luminance(image.at(x, y));
+            sumReference += 0.5 * (a + b);
+            sumVariance += 0.25 * (a - b) * (a - b);  // of this pixel's L(R)
+            ++n;
+        }
+    RatioWithUncertainty out;
+    if (n == 0 || !(sumReference > 0.0)) return out;
+    const double meanReference = sumReference / double(n);
+    const double sigmaMeanReference = std::sqrt(sumVariance) / double(n);
+    out.ratio = (sumImage / double(n)) / meanReference;
+    out.uncertainty = std::abs(out.ratio) * sigmaMeanReference / meanReference;
+    return out;
 }
 
 }  // namespace kiln::metrics

@@ -13,6 +13,46 @@
 
 using namespace kiln::test;
 
+namespace {
+
+// One CSV line's cells (quoted cells may hold commas; the quotes are dropped).
+std::vector<std::string> csvCells(const std::string& line) {
+    std::vector<std::string> cells(1);
+    bool quoted = false;
+    for (char c : line) {
+        if (c == '"') quoted = !quoted;
+        else if (c == ',' && !quoted) cells.emplace_back();
+        else cells.back() += c;
+    }
+    return cells;
+}
+
+// quality.csv as rows of named cells.
+struct QualityCsv {
+    std::vector<std::string> header;
+    std::vector<std::vector<std::string>> rows;
+    explicit QualityCsv(const std::string& text) {
+        std::istringstream in(text);
+        std::string line;
+        if (std::getline(in, line)) header = csvCells(line);
+        while (std::getline(in, line)) rows.push_back(csvCells(line));
+    }
+    int column(const std::string& name) const {
+        for (size_t i = 0; i < header.size(); ++i)
+            if (header[i] == name) return int(i);
+        FAIL("quality.csv has no column " << name);
+        return -1;
+    }
+    // The cell as a number; NaN when empty (SSIM withheld).
+    double number(size_t row, const std::string& name) const {
+        const std::string& cell = rows.at(row).at(size_t(column(name)));
+        return cell.empty() ? std::nan("") : std::stod(cell);
+    }
+    const std::string& text(size_t row, const std::string& name) const { return rows.at(row).at(size_t(column(name))); }
+};
+
+}  // namespace
+
 TEST_CASE("kiln-bench-quality: a tiny sweep writes one finite CSV row per setting and caches the reference",
           "[integration][bench]") {
     const std::string out = std::string(TEST_OUTPUT_DIR) + "/bench-quality";
@@ -22,31 +62,36 @@ TEST_CASE("kiln-bench-quality: a tiny sweep writes one finite CSV row per settin
     Run first = runProgram(KILN_BENCH_QUALITY, args, 300);
     INFO(first.out << first.err);
     REQUIRE(first.exitCode == 0);
-    std::istringstream csv(slurp(out + "/quality.csv"));
-    std::string line;
-    std::getline(csv, line);
-    CHECK(line == "setting,total_gpu_ms,rmse,rel_mse,ssim,psnr,pixels,pareto,rel_mse_indirect,rel_mse_floor,rel_mse_walls,"
-                  "rel_mse_ceiling,rel_mse_objects,pass_ms");
+    const QualityCsv csv(slurp(out + "/quality.csv"));
     int rows = 0, front = 0, seedRows = 0;
-    while (std::getline(csv, line)) {
+    for (size_t i = 0; i < csv.rows.size(); ++i) {
         ++rows;
-        seedRows += line.rfind("\"seed\",", 0) == 0;
-        // "label",ms,rmse,relmse,ssim,psnr,pixels,pareto,indirect,floor,walls,ceiling,objects,"passes"
-        std::istringstream cells(line.substr(line.find("\",") + 2));
-        double v[12];
-        char comma;
-        for (double& x : v) cells >> x >> comma;
-        for (double x : v) CHECK(std::isfinite(x));
-        CHECK(v[0] > 0.0);                  // the passes cost something
-        CHECK(v[1] > 0.0);                  // 8 paths/px: the reference is noisy, never equal
-        CHECK((v[3] > -1.0 && v[3] <= 1.0));  // SSIM
-        CHECK(v[5] > 32 * 32 / 2);          // most pixels counted (emitters masked)
-        front += v[6] == 1.0;
+        seedRows += csv.text(i, "setting") == "seed";
+        for (const char* name : {"total_gpu_ms", "rmse", "rel_mse", "psnr", "pixels", "rel_mse_indirect", "rel_mse_floor",
+                                 "rel_mse_walls", "rel_mse_ceiling", "rel_mse_objects", "rel_mse_corrected",
+                                 "rel_mse_indirect_corrected", "mean_ratio_all", "mean_ratio_all_uncertainty",
+                                 "mean_ratio_floor", "mean_ratio_ceiling", "indirect_ratio_all"}) {
+            INFO(name);
+            CHECK(std::isfinite(csv.number(i, name)));
+        }
+        CHECK(csv.number(i, "total_gpu_ms") > 0.0);  // the passes cost something
+        CHECK(csv.number(i, "rmse") > 0.0);          // 8 paths/px: the reference is noisy, never equal
+        // 8 paths/px: the reference's halves disagree far below SSIM 0.97, so SSIM is withheld.
+        CHECK(csv.text(i, "ssim").empty());
+        CHECK(csv.number(i, "pixels") > 32 * 32 / 2);  // most pixels counted (emitters masked)
+        front += csv.number(i, "pareto") == 1.0;
         // Every part of the box is in view and has an error of its own (the emitter-free
         // ceiling around the lamp included), and so has the indirect part.
-        for (int k = 7; k < 12; ++k) CHECK(v[k] > 0.0);
-        CHECK(line.find("cone_trace=") != std::string::npos);
+        for (const char* name : {"rel_mse_indirect", "rel_mse_floor", "rel_mse_walls", "rel_mse_ceiling", "rel_mse_objects"})
+            CHECK(csv.number(i, name) > 0.0);
+        // The correction removes the reference's own noise: less than the raw figure.
+        CHECK(csv.number(i, "rel_mse_corrected") < csv.number(i, "rel_mse"));
+        CHECK(csv.number(i, "mean_ratio_all") > 0.0);
+        CHECK(csv.number(i, "mean_ratio_all_uncertainty") > 0.0);
+        CHECK(csv.text(i, "pass_ms").find("cone_trace=") != std::string::npos);
     }
+    const std::string summary = slurp(out + "/summary.json");
+    CHECK(summary.find("\"ref_noise_rel_mse\"") != std::string::npos);
     CHECK(rows == 4);  // default, seed (--also), 2 sweep values
     CHECK(seedRows == 1);
     CHECK(front >= 1);
@@ -132,9 +177,11 @@ TEST_CASE("the default pipeline is closer to the path-traced reference than the 
           "[integration][bench][quality]") {
     // The claim behind the default's settings, checked against the independent path
     // tracer rather than against a finer run of the rasterizer: 96² at t = 0.5 s, a
-    // 256-path reference (~30 s here, seeded, so the figures are deterministic).
-    // Measured: relMSE 0.0657 against 0.0805, the indirect part 0.137 against 0.141.
-    // SSIM is not compared: at 96² the seed's is higher by 0.002 (at 256², lower).
+    // 256-path reference in two seeded halves (~3 min here; deterministic figures).
+    // Measured (noise-corrected relMSE): 0.0518 against 0.0717, the indirect part 0.0864
+    // against 0.120; the mean luminance 1.000× the reference's against 0.799× (issue
+    // 22: the seed's one bounce misses a fifth of the light; ±0.002 from the
+    // reference's noise). SSIM is withheld at this path count (the halves disagree).
     const std::string out = std::string(TEST_OUTPUT_DIR) + "/bench-quality-default-vs-seed";
     Run r = runProgram(KILN_BENCH_QUALITY,
                        "--size 96x96 --spp 256 --frames 1 --repeats 1 --sweep composite.exposure=1 "
@@ -142,23 +189,22 @@ TEST_CASE("the default pipeline is closer to the path-traced reference than the 
                        600);
     INFO(r.out << r.err);
     REQUIRE(r.exitCode == 0);
-    std::istringstream csv(slurp(out + "/quality.csv"));
-    std::string line;
-    std::getline(csv, line);
-    double relMse[2] = {-1, -1}, indirect[2] = {-1, -1};
-    while (std::getline(csv, line)) {
-        const int which = line.rfind("\"default\",", 0) == 0 ? 0 : line.rfind("\"seed\",", 0) == 0 ? 1 : -1;
+    const QualityCsv csv(slurp(out + "/quality.csv"));
+    double relMse[2] = {-1, -1}, indirect[2] = {-1, -1}, light[2] = {-1, -1};
+    for (size_t i = 0; i < csv.rows.size(); ++i) {
+        const std::string& label = csv.text(i, "setting");
+        const int which = label == "default" ? 0 : label == "seed" ? 1 : -1;
         if (which < 0) continue;
-        std::istringstream cells(line.substr(line.find("\",") + 2));
-        double v[8];
-        char comma;
-        for (double& x : v) cells >> x >> comma;
-        relMse[which] = v[2];
-        indirect[which] = v[7];
+        relMse[which] = csv.number(i, "rel_mse_corrected");
+        indirect[which] = csv.number(i, "rel_mse_indirect_corrected");
+        light[which] = csv.number(i, "mean_ratio_all");
     }
     INFO("relMSE default " << relMse[0] << " seed " << relMse[1] << "; indirect " << indirect[0] << " / " << indirect[1]);
     REQUIRE(relMse[0] > 0);
     REQUIRE(relMse[1] > 0);
     CHECK(relMse[0] < relMse[1]);
     CHECK(indirect[0] < indirect[1]);
+    INFO("mean luminance ÷ the reference's: default " << light[0] << ", seed " << light[1]);
+    CHECK(std::abs(light[0] - 1.0) < 0.03);
+    CHECK(light[1] < 0.9);
 }

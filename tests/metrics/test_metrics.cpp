@@ -134,3 +134,124 @@ TEST_CASE("metrics: RMSE and PSNR agree with OpenImageIO's idiff on EXR files Ki
     INFO("peak " << peak);
     CHECK(m::psnr(ours, peak) == Approx(idiffPsnr).epsilon(2e-6));
 }
+
+// A reference made of two independent halves A and B (see metrics.hpp). The halves
+// here are a known truth T plus independent Gaussian noise, so every expected value is
+// a closed form in T, σ and ε; tolerances allow for the sampling noise of 128² pixels
+// and for the bias of the noisy denominator R² + ε (a few per cent at these settings).
+namespace {
+
+// `truth` plus independent N(0, sigma²) noise on each pixel's RGB.
+FloatImage withGaussianNoise(const FloatImage& truth, float sigma, unsigned seed) {
+    FloatImage img = truth;
+    std::mt19937 rng(seed);
+    std::normal_distribution<float> n(0.0f, sigma);
+    for (int y = 0; y < img.height; ++y)
+        for (int x = 0; x < img.width; ++x)
+            for (int c = 0; c < 3; ++c) img.at(x, y)[c] += n(rng);
+    return img;
+}
+
+}  // namespace
+
+TEST_CASE("metrics: against a noisy reference, the truth itself has a noise-corrected relMSE near 0", "[metrics]") {
+    const int w = 128, h = 128;
+    const double truth = 0.5, sigma = 0.05, eps = m::kRelMseEpsilon;
+    const FloatImage t = constant(w, h, {float(truth), float(truth), float(truth)});
+    const FloatImage a = withGaussianNoise(t, float(sigma), 11), b = withGaussianNoise(t, float(sigma), 12);
+    // R = (A + B)/2 has variance σ²/2 per channel, so its relMSE against the truth is
+    // about (σ²/2)/(T² + ε) = 0.00125/0.26 = 0.00481.
+    const double noiseRelMse = (sigma * sigma / 2) / (truth * truth + eps);
+    const double raw = m::relativeMse(t, m::average(a, b));
+    INFO("raw " << raw << ", expected noise " << noiseRelMse);
+    CHECK(raw == Approx(noiseRelMse).epsilon(0.10));  // the raw figure is all reference noise
+    CHECK(m::referenceNoiseRelativeMse(a, b) == Approx(noiseRelMse).epsilon(0.10));
+    // Corrected: within 10 % of the noise it removed (measured: ~3 %, the denominator's
+    // bias at T = 0.5 with σ(R)/T = 7 %).
+    const double corrected = m::noiseCorrectedRelativeMse(t, a, b);
+    INFO("corrected " << corrected);
+    CHECK(std::abs(corrected) < 0.10 * noiseRelMse);
+    // Same denominators: the corrected figure is the raw one less the noise floor.
+    CHECK(raw - m::referenceNoiseRelativeMse(a, b) == Approx(corrected).margin(1e-12));
+}
+
+TEST_CASE("metrics: the noise-corrected relMSE of a biased image is its relMSE against the truth", "[metrics]") {
+    const int w = 128, h = 128;
+    const double truth = 0.5, sigma = 0.03, offset = 0.05, eps = m::kRelMseEpsilon;
+    const FloatImage t = constant(w, h, {float(truth), float(truth), float(truth)});
+    // ± offset on alternate pixels: the same error everywhere, and the noisy denominator's
+    // first-order bias (∝ K − T, metrics.hpp) cancels between the two signs.
+    FloatImage k = t;
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            for (int c = 0; c < 3; ++c) k.at(x, y)[c] += float((x + y) % 2 ? offset : -offset);
+    const FloatImage a = withGaussianNoise(t, float(sigma), 21), b = withGaussianNoise(t, float(sigma), 22);
+    const double trueRelMse = offset * offset / (truth * truth + eps);            // 0.0025/0.26 = 0.00962
+    const double noiseRelMse = (sigma * sigma / 2) / (truth * truth + eps);       // 0.00045/0.26 = 0.00173
+    const double raw = m::relativeMse(k, m::average(a, b)), corrected = m::noiseCorrectedRelativeMse(k, a, b);
+    INFO("raw " << raw << ", corrected " << corrected << ", true " << trueRelMse);
+    // The raw figure is ~18 % too high; the corrected one within 4 % (measured ~1 %).
+    CHECK(raw == Approx(trueRelMse + noiseRelMse).epsilon(0.04));
+    CHECK(corrected == Approx(trueRelMse).epsilon(0.04));
+    // A mask leaves out pixels whatever their values.
+    FloatImage kOff = k;
+    kOff.at(0, 0)[0] = 1000.0f;
+    m::Mask mask(size_t(w) * h, 1);
+    mask[0] = 0;
+    CHECK(m::noiseCorrectedRelativeMse(kOff, a, b, mask) == Approx(trueRelMse).epsilon(0.04));
+}
+
+TEST_CASE("metrics: mean luminance is Rec. 709 on linear RGB, and a 10 % brighter image has a ratio of 1.10", "[metrics]") {
+    const FloatImage c = constant(4, 4, {0.2f, 0.4f, 0.6f});
+    CHECK(m::meanLuminance(c) == Approx(0.2126 * 0.2 + 0.7152 * 0.4 + 0.0722 * 0.6).epsilon(1e-6));
+
+    const int w = 64, h = 64;
+    const FloatImage t = noise(w, h, 31, 0.2f, 1.0f);
+    FloatImage k = t;
+    for (size_t i = 0; i < k.pixels.size(); ++i)
+        if (i % 4 != 3) k.pixels[i] *= 1.1f;
+    CHECK(m::meanLuminanceRatio(k, t) == Approx(1.1).epsilon(1e-6));  // exact truth: float rounding only
+    // Against a noisy reference (σ = 0.05 a channel a half): the ratio within 0.005 of
+    // 1.10 (its own σ is ~0.0008 here), and the stated uncertainty close to the closed
+    // form 1.1 · σ(mean L(R)) / mean L(T), σ(mean L(R)) = √(Σ w²) · σ/√2 / √n.
+    const double sigma = 0.05;
+    const FloatImage a = withGaussianNoise(t, float(sigma), 32), b = withGaussianNoise(t, float(sigma), 33);
+    const m::RatioWithUncertainty r = m::meanLuminanceRatio(k, a, b);
+    const double sumW2 = 0.2126 * 0.2126 + 0.7152 * 0.7152 + 0.0722 * 0.0722;
+    const double expectedSigma = 1.1 * std::sqrt(sumW2) * sigma / std::sqrt(2.0) / std::sqrt(double(w * h)) / m::meanLuminance(t);
+    INFO("ratio " << r.ratio << " ± " << r.uncertainty << ", expected ± " << expectedSigma);
+    CHECK(r.ratio == Approx(1.1).margin(0.005));
+    CHECK(r.uncertainty == Approx(expectedSigma).epsilon(0.05));
+    // Masked out: an "emitter" far brighter in the image than in the reference.
+    FloatImage kGlow = k;
+    kGlow.at(5, 5)[0] = kGlow.at(5, 5)[1] = kGlow.at(5, 5)[2] = 500.0f;
+    m::Mask mask(size_t(w) * h, 1);
+    mask[5 * w + 5] = 0;
+    CHECK(m::meanLuminanceRatio(kGlow, t) > 1.2);  // 500/4096 more on a mean of ~0.6: ~1.30
+    CHECK(m::meanLuminanceRatio(kGlow, t, mask) == Approx(1.1).epsilon(1e-6));
+    // Nothing counted, or a black reference: no ratio.
+    CHECK(std::isnan(m::meanLuminanceRatio(k, t, m::Mask(size_t(w) * h, 0))));
+    CHECK(std::isnan(m::meanLuminanceRatio(k, constant(w, h, {0, 0, 0}))));
+}
+
+TEST_CASE("metrics: the luminance ratio's stated uncertainty is its spread over independent references", "[metrics]") {
+    // 400 references of 16² pixels, each two fresh halves: the standard deviation of the
+    // ratios must match the RMS of the stated uncertainties within 15 % (the spread of
+    // 400 draws is itself known to ~4 %). The ± half the difference of the ratios
+    // against A and against B alone would average only √(2/π) ≈ 0.8 of it.
+    const int w = 16, h = 16, trials = 400;
+    const FloatImage t = noise(w, h, 41, 0.2f, 1.0f);
+    FloatImage k = t;
+    for (size_t i = 0; i < k.pixels.size(); ++i) k.pixels[i] *= 0.9f;
+    double sum = 0, sumSquares = 0, sumUncertaintySquares = 0;
+    for (int i = 0; i < trials; ++i) {
+        const m::RatioWithUncertainty r =
+            m::meanLuminanceRatio(k, withGaussianNoise(t, 0.1f, 1000 + 2 * i), withGaussianNoise(t, 0.1f, 1001 + 2 * i));
+        sum += r.ratio, sumSquares += r.ratio * r.ratio, sumUncertaintySquares += r.uncertainty * r.uncertainty;
+    }
+    const double mean = sum / trials, spread = std::sqrt((sumSquares - trials * mean * mean) / (trials - 1));
+    const double stated = std::sqrt(sumUncertaintySquares / trials);
+    INFO("mean " << mean << ", spread " << spread << ", stated " << stated);
+    CHECK(mean == Approx(0.9).margin(0.002));
+    CHECK(stated == Approx(spread).epsilon(0.15));
+}
