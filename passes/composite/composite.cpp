@@ -6,6 +6,12 @@
 // emitted radiance (see passes/bloom), so no separate "lighting" pass is needed.
 #include <kiln/pass.hpp>
 
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include <glm/glm.hpp>
+
 namespace {
 
 class Composite final : public kiln::Pass {
@@ -39,7 +45,7 @@ public:
                              "from the indirect input's alpha"))
             .param(floatParam("lamp_near_field", 0.2f, 0.0, 4.0,
                               "lamp_model traced: within this many metres of the dome the contour is evaluated per "
-                              "pixel (the irradiance changes faster there than the traced samples)"))
+                              "pixel (the irradiance changes faster there than the traced samples); 0 compiles that out"))
             .param(intChoiceParam("lamp_samples", 32, {4, 8, 16, 32, 64},
                                   "vertices of the lamp's silhouette (contour) or quadrature points over its cap (points)"));
         d.reads = kSceneLight | kSceneCamera;
@@ -47,17 +53,24 @@ public:
     }
 
     void execute(kiln::PassContext& ctx) override {
-        GLuint program = ctx.program({.stages = {"common/fullscreen.vert", "composite/composite.frag"},
-                                      .defines = {{"KILN_LAMP_SAMPLES", std::to_string(ctx.getInt("lamp_samples"))},
-                                                  {"KILN_LAMP_CONTOUR", ctx.getEnum("lamp_model") == "points" ? "0" : "1"},
-                                                  {"KILN_LAMP_TRACED", ctx.getEnum("lamp_model") == "traced" ? "1" : "0"},
-                                                  {"KILN_PCF", std::to_string(ctx.getInt("pcf"))}}});
+        const std::string& lampModel = ctx.getEnum("lamp_model");
+        auto variant = [&](bool nearField) {
+            return ctx.program({.stages = {"common/fullscreen.vert", "composite/composite.frag"},
+                                .defines = {{"KILN_LAMP_SAMPLES", std::to_string(ctx.getInt("lamp_samples"))},
+                                            {"KILN_LAMP_CONTOUR", lampModel == "points" ? "0" : "1"},
+                                            {"KILN_LAMP_TRACED", lampModel == "traced" ? "1" : "0"},
+                                            {"KILN_LAMP_NEAR_FIELD", nearField ? "1" : "0"},
+                                            {"KILN_PCF", std::to_string(ctx.getInt("pcf"))}}});
+        };
+        GLuint program = variant(false);
         if (!program) return;
-        if (ctx.getEnum("lamp_model") == "traced" && !ctx.isBound("indirect"))
+        const bool nearField = lampModel == "traced" && ctx.getFloat("lamp_near_field") > 0.0f;
+        GLuint nearProgram = nearField ? variant(true) : 0;
+        if (nearField && !nearProgram) return;
+        if (lampModel == "traced" && !ctx.isBound("indirect"))
             return ctx.fail("lamp_model traced reads the lamp from `indirect` (cone_trace.indirect with cone_trace's "
                             "`lamp` on): bind it, or use lamp_model contour");
         if (!ctx.framebuffer({"color", "hdr"})) return;
-        glUseProgram(program);
         const char* inputs[] = {"albedo", "normal", "depth", "emissive", "shadow_map", "indirect", "bloom"};
         for (GLuint unit = 0; unit < 7; ++unit) glBindTextureUnit(unit, ctx.input(inputs[unit]).id);
         // The shadow map is read through hardware comparison (sampler2DShadow): each
@@ -73,6 +86,28 @@ public:
             glSamplerParameteri(compareSampler_, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
         }
         glBindSampler(4, compareSampler_);
+        draw(ctx, program);
+        // The near field again, per pixel, over its screen rectangle only.
+        if (nearField) {
+            const glm::vec4 lamp = ctx.scene().frame.lightPos;
+            const Rect r = screenRect(ctx, glm::vec3(lamp), lamp.w + ctx.getFloat("lamp_near_field"));
+            if (r.width > 0 && r.height > 0) {
+                glEnable(GL_SCISSOR_TEST);
+                glScissor(r.x, r.y, r.width, r.height);
+                draw(ctx, nearProgram);
+                glDisable(GL_SCISSOR_TEST);
+            }
+        }
+        glBindSampler(4, 0);
+    }
+
+    ~Composite() override {
+        if (compareSampler_) glDeleteSamplers(1, &compareSampler_);
+    }
+
+private:
+    static void draw(kiln::PassContext& ctx, GLuint program) {
+        glUseProgram(program);
         const std::string& tonemap = ctx.getEnum("tonemap");
         glUniform1f(glGetUniformLocation(program, "u_exposure"), ctx.getFloat("exposure"));
         glUniform1f(glGetUniformLocation(program, "u_ambient"), ctx.getFloat("ambient"));
@@ -82,14 +117,29 @@ public:
         glUniform1f(glGetUniformLocation(program, "u_indirectStrength"), ctx.getFloat("indirect_strength"));
         glUniform1f(glGetUniformLocation(program, "u_lampNearField"), ctx.getFloat("lamp_near_field"));
         ctx.drawFullscreenTriangle();
-        glBindSampler(4, 0);
     }
 
-    ~Composite() override {
-        if (compareSampler_) glDeleteSamplers(1, &compareSampler_);
+    struct Rect {
+        int x = 0, y = 0, width = 0, height = 0;
+    };
+    // The pixels a sphere can cover: its bounding box's corners projected; the whole
+    // output when one is behind the camera.
+    static Rect screenRect(kiln::PassContext& ctx, glm::vec3 centre, float radius) {
+        const int w = ctx.frame().outputWidth, h = ctx.frame().outputHeight;
+        glm::vec2 lo(1.0f), hi(-1.0f);
+        for (int i = 0; i < 8; ++i) {
+            const glm::vec3 corner = centre + radius * glm::vec3(i & 1 ? 1 : -1, i & 2 ? 1 : -1, i & 4 ? 1 : -1);
+            const glm::vec4 clip = ctx.scene().frame.viewProj * glm::vec4(corner, 1.0f);
+            if (clip.w <= 1e-4f) return {0, 0, w, h};
+            lo = glm::min(lo, glm::vec2(clip) / clip.w);
+            hi = glm::max(hi, glm::vec2(clip) / clip.w);
+        }
+        lo = glm::clamp(lo, -1.0f, 1.0f), hi = glm::clamp(hi, -1.0f, 1.0f);
+        const int x0 = int(std::floor((lo.x * 0.5f + 0.5f) * w)), y0 = int(std::floor((lo.y * 0.5f + 0.5f) * h));
+        const int x1 = int(std::ceil((hi.x * 0.5f + 0.5f) * w)), y1 = int(std::ceil((hi.y * 0.5f + 0.5f) * h));
+        return {x0, y0, std::max(0, x1 - x0), std::max(0, y1 - y0)};
     }
 
-private:
     GLuint compareSampler_ = 0;
 };
 

@@ -57,11 +57,13 @@ void main() {
 #if KILN_LAMP_TRACED
         // cone_trace's `lamp`: the projected solid angle where it traced, upsampled. Within
         // u_lampNearField of the dome it changes faster than those samples: evaluated
-        // here. A loop that runs once or not at all, because llvmpipe leaves a loop when
-        // no lane has work but runs an `if` body for every lane.
+        // here, by the variant composite.cpp draws over the near field's screen
+        // rectangle only (on llvmpipe the contour's mere presence in the shader cost
+        // every pixel of the frame, used or not).
         float solidAngle = texture(u_indirect, v_uv).a;
-        for (int near = distance(p, u_lightPos.xyz) < u_lightPos.w + u_lampNearField ? 1 : 0; near > 0; --near)
-            solidAngle = lampProjectedSolidAngle(p, n);
+#if KILN_LAMP_NEAR_FIELD
+        if (distance(p, u_lightPos.xyz) < u_lightPos.w + u_lampNearField) solidAngle = lampProjectedSolidAngle(p, n);
+#endif
         vec3 irradiance = u_lightColor.rgb * solidAngle;
 #else
         vec3 irradiance = lampLight(p, n);

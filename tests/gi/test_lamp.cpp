@@ -194,8 +194,9 @@ TEST_CASE("lamp: traced at one pixel in 4×4 and upsampled, the lamp's light sta
           "[gi][lamp]") {
     // composite lamp_model traced reads the lamp's projected solid angle from cone_trace
     // (one traced pixel per 4×4, upsampled to half size, then bilinear), except within
-    // lamp_near_field of the dome, where it evaluates the contour per pixel as lamp_model
-    // contour does everywhere. Compared on the direct light alone (indirect_strength 0),
+    // lamp_near_field (0.2 here) of the dome, where it evaluates the contour per pixel as
+    // lamp_model contour does everywhere (a second draw, scissored to the near field's
+    // screen rectangle). Compared on the direct light alone (indirect_strength 0),
     // the shipped scene at t = 0, 96²: the frame's mean within 2 %, and the pixels within
     // the near field exactly equal (the same code on the same inputs).
     test::Rig rig(KILN_SOURCE_DIR "/scenes/cornell.json", 96);
@@ -205,6 +206,7 @@ TEST_CASE("lamp: traced at one pixel in 4×4 and upsampled, the lamp's light sta
             if (pass["id"] == "composite") {
                 pass["params"]["lamp_model"] = model;
                 pass["params"]["lamp_samples"] = 32;
+                pass["params"]["lamp_near_field"] = 0.2;
                 pass["params"]["indirect_strength"] = 0.0;
             }
         rig.load(p.dump(), {"composite.hdr", "gbuffer.depth"});
