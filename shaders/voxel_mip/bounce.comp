@@ -12,8 +12,10 @@
 // and the whole sphere (|m| = 0: surfaces facing every way, e.g. a ball in the block):
 //     w(d) = |m| · max(m̂·d, 0) + (1 − |m|) / 4
 // (1/4: the mean of max(n·d, 0) over the sphere), normalised over the cones traced.
-#include "cone_trace/trace.glsl"
+// fixed_cones.glsl first: trace.glsl's voxels.glsl includes it only inside
+// `#if KILN_HAS_FIXED_CONES`, and a file is included once per stage.
 #include "common/fixed_cones.glsl"
+#include "cone_trace/trace.glsl"
 
 layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
 layout(binding = 0) uniform sampler3D u_emitted;  // voxelize.radiance: direct light + emission

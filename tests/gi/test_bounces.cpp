@@ -16,18 +16,19 @@ using namespace kiln::test;
 
 namespace {
 
-// The rasterized pipeline of pipelines/default.json with `bounces`, voxels at 32³.
-std::string rasterPipeline(int bounces) {
+// The rasterized pipeline of pipelines/default.json with `bounces`, voxels at 32³, the
+// chains of voxel_mip `mode` (fixed_cones, aniso or iso).
+std::string rasterPipeline(int bounces, const std::string& mode = "fixed_cones") {
+    const std::string chain = mode == "iso" ? "" : R"(, ")" + mode + R"(": "voxel_mip.)" + mode + R"(")";
     return pipeline("composite.color", R"(
         {"id": "gbuffer", "module": "gbuffer"},
         {"id": "shadow", "module": "shadow", "params": {"size": 256}},
         {"id": "voxelize", "module": "voxelize", "inputs": {"shadow_map": "shadow.depth"}, "params": {"resolution": 32}},
         {"id": "voxel_mip", "module": "voxel_mip",
          "inputs": {"radiance": "voxelize.radiance", "albedo": "voxelize.albedo", "normal": "voxelize.normal"},
-         "params": {"mode": "fixed_cones", "bounces": )" + std::to_string(bounces) + R"(}},
+         "params": {"mode": ")" + mode + R"(", "bounces": )" + std::to_string(bounces) + R"(}},
         {"id": "cone_trace", "module": "cone_trace",
-         "inputs": {"normal": "gbuffer.normal", "depth": "gbuffer.depth", "voxels": "voxel_mip.iso",
-                    "fixed_cones": "voxel_mip.fixed_cones"},
+         "inputs": {"normal": "gbuffer.normal", "depth": "gbuffer.depth", "voxels": "voxel_mip.iso")" + chain + R"(},
          "params": {"trace_stride": 1}},
         {"id": "composite", "module": "composite",
          "inputs": {"albedo": "gbuffer.albedo", "normal": "gbuffer.normal", "depth": "gbuffer.depth",
@@ -50,8 +51,8 @@ double meanLuminance(const FloatImage& img, const std::vector<bool>& keep = {}) 
     return sum / std::max(counted, 1);
 }
 
-FloatImage rasterFrame(Rig& rig, int bounces) {
-    rig.load(rasterPipeline(bounces), {"composite.hdr", "gbuffer.emissive"});
+FloatImage rasterFrame(Rig& rig, int bounces, const std::string& mode = "fixed_cones") {
+    rig.load(rasterPipeline(bounces, mode), {"composite.hdr", "gbuffer.emissive"});
     rig.app.frame();
     rig.checkNoErrors();
     return rig.image("composite", "hdr");
@@ -81,7 +82,12 @@ TEST_CASE("voxel_mip bounces: the white furnace — k bounces show 2 − 0.5^k o
     // wall or misses its weight shows up here, in every bounce. Measured within 0.41 %
     // (k = 1) and 0.1 % (k = 2…4); the tolerance, 2 %, leaves room for another cone
     // schedule and still fails a bounce that is missing (1.5 against 1.75) or a cone
-    // set that loses a twentieth of the light.
+    // set that loses a twentieth of the light. Both directional modes of the chains
+    // the bounces are gathered through (aniso: 1.507 / 1.753 / 1.876 / 1.937). Not iso:
+    // its averaged coarse levels let cones through the one-voxel walls, so a furnace
+    // frame shows 1.21 at k = 1 and 1.27 at k = 4 — the seed's self-occlusion finding,
+    // seen as lost energy.
+    const std::string mode = GENERATE(std::string("fixed_cones"), std::string("aniso"));
     Rig rig(writeScene("furnace_bounces.json", R"({
         "box": {"left": [0.5, 0.5, 0.5], "right": [0.5, 0.5, 0.5], "other": [0.5, 0.5, 0.5],
                 "floor_wood": {"light": [0.5, 0.5, 0.5], "dark": [0.5, 0.5, 0.5]},
@@ -92,9 +98,9 @@ TEST_CASE("voxel_mip bounces: the white furnace — k bounces show 2 − 0.5^k o
     rig.app.camera().distance = 0.5f;  // inside the box
     double previous = 1.0;             // emission alone
     for (int k = 1; k <= 4; ++k) {
-        const double mean = meanLuminance(rasterFrame(rig, k));
+        const double mean = meanLuminance(rasterFrame(rig, k, mode));
         const double expected = 2.0 - std::pow(0.5, k);
-        INFO("bounces " << k << ": mean radiance " << mean << ", expected " << expected);
+        INFO(mode << ", bounces " << k << ": mean radiance " << mean << ", expected " << expected);
         CHECK(std::abs(mean - expected) < 0.02 * expected);
         // Each bounce adds light, and about half the last one's increment.
         CHECK(mean > previous);
