@@ -67,9 +67,10 @@ TEST_CASE("a floor point in a tumbler's shadow is darker than its lit neighbour"
     const float* l = img.at(int(lit.x), int(lit.y));
     const float sLum = s[0] + s[1] + s[2], lLum = l[0] + l[1] + l[2];
     INFO("shadowed " << sLum << " at " << shadowed.x << "," << shadowed.y << "; lit " << lLum);
-    // In shadow only the ambient term remains (0.03 × albedo vs ≈ 1.2 × albedo × cos θ
-    // lit): a factor 3 is a loose bound that a missing or misplaced shadow breaks.
-    CHECK(sLum * 3.0f < lLum);
+    // In shadow only the indirect light remains: measured 0.35 against 1.01 lit with
+    // the default's two bounces (the path tracer agrees the box is that bright). A
+    // factor 2 still fails a missing or misplaced shadow (ratio ≈ 1).
+    CHECK(sLum * 2.0f < lLum);
 }
 
 TEST_CASE("the shadow pass is skipped while no caster moves and runs when one does", "[scene][gl]") {
