@@ -19,21 +19,6 @@ void checkShapes(const FloatImage& a, const FloatImage& b, const Mask& mask) {
 
 bool counted(const Mask& mask, size_t pixel) { return mask.empty() || mask[pixel] != 0; }
 
-// Mean over counted pixels and the RGB channels of f(image value, reference value).
-template <class F>
-double meanOver(const FloatImage& a, const FloatImage& b, const Mask& mask, F f) {
-    checkShapes(a, b, mask);
-    double sum = 0.0;
-    size_t n = 0;
-    for (int y = 0; y < a.height; ++y)
-        for (int x = 0; x < a.width; ++x) {
-            if (!counted(mask, size_t(y) * a.width + x)) continue;
-            for (int c = 0; c < 3; ++c) sum += f(double(a.at(x, y)[c]), double(b.at(x, y)[c]));
-            n += 3;
-        }
-    return n ? sum / double(n) : 0.0;
-}
-
 // Mean over counted pixels and the RGB channels of f(k, a, b), one value of each image.
 template <class F>
 double meanOver3(const FloatImage& k, const FloatImage& a, const FloatImage& b, const Mask& mask, F f) {
@@ -49,6 +34,12 @@ double meanOver3(const FloatImage& k, const FloatImage& a, const FloatImage& b, 
             n += 3;
         }
     return n ? sum / double(n) : 0.0;
+}
+
+// Mean over counted pixels and the RGB channels of f(image value, reference value).
+template <class F>
+double meanOver(const FloatImage& a, const FloatImage& b, const Mask& mask, F f) {
+    return meanOver3(a, b, b, mask, [&f](double image, double reference, double) { return f(image, reference); });
 }
 
 double aces(double x) {

@@ -22,6 +22,15 @@ inline std::string writeScene(const std::string& name, const std::string& json) 
     return file.string();
 }
 inline const char* kEmptyBox = R"({"tumblers": [], "marbles": [], "fireballs": []})";
+// The white furnace: a closed box whose every surface (the floor's both wood colours and
+// the lamp dome too: colour 0.5 × intensity 2) has albedo 0.5 and emits 1, so the
+// radiance everywhere is 1/(1 − 0.5) = 2. Put the camera inside (distance 0.5).
+inline const char* kFurnaceBox = R"({
+    "box": {"left": [0.5, 0.5, 0.5], "right": [0.5, 0.5, 0.5], "other": [0.5, 0.5, 0.5],
+            "floor_wood": {"light": [0.5, 0.5, 0.5], "dark": [0.5, 0.5, 0.5]},
+            "emission": [1, 1, 1], "closed": true},
+    "lamp": {"color": [0.5, 0.5, 0.5], "intensity": 2.0},
+    "tumblers": [], "marbles": [], "fireballs": []})";
 
 // One App, paused (time frozen), with the GI test module directory on the path.
 struct Rig {

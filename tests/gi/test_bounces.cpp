@@ -88,13 +88,7 @@ TEST_CASE("voxel_mip bounces: the white furnace — k bounces show 2 − 0.5^k o
     // frame shows 1.21 at k = 1 and 1.27 at k = 4 — the seed's self-occlusion finding,
     // seen as lost energy.
     const std::string mode = GENERATE(std::string("fixed_cones"), std::string("aniso"));
-    Rig rig(writeScene("furnace_bounces.json", R"({
-        "box": {"left": [0.5, 0.5, 0.5], "right": [0.5, 0.5, 0.5], "other": [0.5, 0.5, 0.5],
-                "floor_wood": {"light": [0.5, 0.5, 0.5], "dark": [0.5, 0.5, 0.5]},
-                "emission": [1, 1, 1], "closed": true},
-        "lamp": {"color": [0.5, 0.5, 0.5], "intensity": 2.0},
-        "tumblers": [], "marbles": [], "fireballs": []})"),
-            48);
+    Rig rig(writeScene("furnace_bounces.json", kFurnaceBox), 48);
     rig.app.camera().distance = 0.5f;  // inside the box
     double previous = 1.0;             // emission alone
     for (int k = 1; k <= 4; ++k) {

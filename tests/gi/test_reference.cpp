@@ -56,13 +56,7 @@ TEST_CASE("reference: white furnace — a closed box of albedo ρ emitting Lₑ 
     // unbiased, so the mean over 32² pixels × 64 paths (65 536 paths; the per-path
     // standard deviation here is ≈ 1.4, so the mean's is ≈ 0.006 = 0.3 %) must be within
     // 1 % of 2, and every pixel within 25 % (64 paths each: ≈ 9 % standard deviation).
-    Rig rig(writeScene("furnace.json", R"({
-        "box": {"left": [0.5, 0.5, 0.5], "right": [0.5, 0.5, 0.5], "other": [0.5, 0.5, 0.5],
-                "floor_wood": {"light": [0.5, 0.5, 0.5], "dark": [0.5, 0.5, 0.5]},
-                "emission": [1, 1, 1], "closed": true},
-        "lamp": {"color": [0.5, 0.5, 0.5], "intensity": 2.0},
-        "tumblers": [], "marbles": [], "fireballs": []})"),
-            32);
+    Rig rig(writeScene("furnace.json", kFurnaceBox), 32);
     rig.app.camera().distance = 0.5f;  // inside the box, looking at the back wall
     FloatImage img = render(rig, 64, 1, 4, 256);
     double sum = 0.0, worst = 0.0;
