@@ -45,6 +45,8 @@
 //    no other setting beats on both; plots every setting, the front and the default
 //    (DIR/quality.png, log-log: settings at or below 0 are left off). Writes
 //    DIR/quality.csv (one row per setting) and DIR/summary.json (the header's figures).
+//    The ceiling within 0.5 m of the lamp's axis, where the lamp's near field is, gets
+//    its own corrected relMSE beside the reference's noise there, and its bias.
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -295,7 +297,11 @@ bool loadReference(app::App& app, const Args& args, Reference& ref) {
 enum Region { kFloor, kWalls, kCeiling, kObjects, kRegionCount };
 const char* const kRegionNames[kRegionCount] = {"floor", "walls", "ceiling", "objects"};
 
-std::vector<int> regionsOf(const app::App& app, const FloatImage& depth) {
+// Also marks `domeRing`: the ceiling within 0.5 m of the lamp's vertical axis, where the
+// lamp's near field is (the issue-22 diagnosis counted 708 such pixels at 256²).
+std::vector<int> regionsOf(app::App& app, const FloatImage& depth, metrics::Mask& domeRing) {
+    const glm::vec2 lampAxis(app.scene().look().lampCentre.x, app.scene().look().lampCentre.z);
+    domeRing.assign(size_t(depth.width) * depth.height, 0);
     const glm::mat4 invViewProj = glm::inverse(app.camera().projection(float(depth.width) / float(depth.height)) *
                                                app.camera().view());
     std::vector<int> region(size_t(depth.width) * depth.height, -1);
@@ -308,7 +314,10 @@ std::vector<int> regionsOf(const app::App& app, const FloatImage& depth) {
             p /= p.w;
             int r = kObjects;
             if (p.y < -kOnWall) r = kFloor;
-            else if (p.y > kOnWall) r = kCeiling;
+            else if (p.y > kOnWall) {
+                r = kCeiling;
+                domeRing[size_t(y) * depth.width + x] = glm::distance(glm::vec2(p.x, p.z), lampAxis) < 0.5f;
+            }
             else if (std::abs(p.x) > kOnWall || p.z < -kOnWall) r = kWalls;
             region[size_t(y) * depth.width + x] = r;
         }
@@ -330,6 +339,10 @@ struct Result {
     double relMseCorrected = 0, indirectRelMseCorrected = 0;
     // Mean luminance of the setting ÷ that of R, total and indirect, per part.
     metrics::RatioWithUncertainty meanRatio[kPartCount], indirectRatio[kPartCount];
+    // The ceiling around the dome: corrected relMSE, the reference's own noise there, bias.
+    double ringRelMseCorrected = 0, ringNoise = 0;
+    int ringPixels = 0;
+    metrics::RatioWithUncertainty ringRatio;
     metrics::Mask counted;  // the pixels the figures count (emitters out)
     bool pareto = false;
 };
@@ -373,7 +386,16 @@ bool measure(app::App& app, const Args& args, const Setting& setting, const Refe
 
     const TextureRef* depth = app.runtime().findTexture("gbuffer", "depth");
     if (!depth) return fail(setting.label + ": the pipeline has no gbuffer.depth");
-    const std::vector<int> region = regionsOf(app, readTexture(depth->id, depth->target, depth->format, depth->width, depth->height));
+    metrics::Mask ring;
+    const std::vector<int> region =
+        regionsOf(app, readTexture(depth->id, depth->target, depth->format, depth->width, depth->height), ring);
+    for (size_t i = 0; i < ring.size(); ++i) ring[i] = ring[i] && mask[i];
+    r.ringPixels = int(std::count(ring.begin(), ring.end(), 1));
+    if (r.ringPixels > 0) {
+        r.ringRelMseCorrected = metrics::noiseCorrectedRelativeMse(image, halfA, halfB, ring);
+        r.ringNoise = metrics::referenceNoiseRelativeMse(halfA, halfB, ring);
+        r.ringRatio = metrics::meanLuminanceRatio(image, halfA, halfB, ring);
+    }
     std::vector<metrics::Mask> partMask(kPartCount, mask);
     for (int k = 0; k < kRegionCount; ++k) {
         metrics::Mask& m = partMask[1 + k];
@@ -498,7 +520,8 @@ int main(int argc, char** argv) {
     csv << ",rel_mse_corrected,rel_mse_indirect_corrected";
     for (const char* kind : {"mean_ratio_", "indirect_ratio_"})
         for (const char* part : kPartNames) csv << ',' << kind << part << ',' << kind << part << "_uncertainty";
-    csv << ",pass_ms\n";
+    csv << ",dome_ring_pixels,rel_mse_dome_ring_corrected,ref_noise_dome_ring,mean_ratio_dome_ring,"
+           "mean_ratio_dome_ring_uncertainty,pass_ms\n";
     std::printf("%-44s %9s %9s %9s %9s %7s %7s %9s %9s  %-31s %s\n", "setting", "gpu ms", "RMSE", "relMSE", "corrected",
                 "SSIM", "PSNR", "indirect", "corrected", "relMSE floor/walls/ceil/objects", "front");
     for (auto& r : results) {
@@ -518,6 +541,8 @@ int main(int argc, char** argv) {
         for (const auto* ratios : {r.meanRatio, r.indirectRatio})
             for (int p = 0; p < kPartCount; ++p)
                 csv << ',' << csvNumber(ratios[p].ratio) << ',' << csvNumber(ratios[p].uncertainty);
+        csv << ',' << r.ringPixels << ',' << r.ringRelMseCorrected << ',' << r.ringNoise << ','
+            << csvNumber(r.ringRatio.ratio) << ',' << csvNumber(r.ringRatio.uncertainty);
         csv << ",\"" << passes << "\"\n";
     }
     std::printf("\n* = on the Pareto front of (GPU ms, corrected relMSE); corrected = less the reference's own noise\n\n");
@@ -536,6 +561,13 @@ int main(int argc, char** argv) {
             for (int p = 0; p < kPartCount; ++p) std::printf(" %s", ratioCell(ratios[p]).c_str());
         }
         std::printf("\n");
+    }
+    if (!results.empty() && results.front().ringPixels > 0) {
+        std::printf("\nthe ceiling within 0.5 m of the lamp's axis (%d px; the reference's own relMSE there %.5f):\n",
+                    results.front().ringPixels, results.front().ringNoise);
+        std::printf("%-44s %12s %14s\n", "setting", "corrected", "mean light");
+        for (auto& r : results)
+            std::printf("%-44s %12.5f %14s\n", r.label.c_str(), r.ringRelMseCorrected, ratioCell(r.ringRatio).c_str());
     }
 
     LogLogPlot plot{"GPU ms against error vs the reference", "total GPU ms per frame",
