@@ -141,3 +141,35 @@ TEST_CASE("voxel_mip bounces: each bounce adds what the path tracer's next path 
         previousRaster = raster, previousReference = reference;
     }
 }
+
+TEST_CASE("voxel_mip bounces and composite's traced lamp refuse what they cannot honour, by name, and recover",
+          "[gi][bounces][errors]") {
+    // Bounces need what each voxel reflects and which way it faces; the traced lamp
+    // needs cone_trace's output. Without them the pass fails with the missing binding
+    // named (the host shows it and keeps running), and binding them clears it.
+    Rig rig(writeScene("empty_box_errors.json", kEmptyBox), 24);
+    std::string text = rasterPipeline(2);
+    const std::string surfaces = R"(, "albedo": "voxelize.albedo", "normal": "voxelize.normal")";
+    text.replace(text.find(surfaces), surfaces.size(), "");
+    rig.load(text, {"composite.hdr"});
+    rig.app.frame();
+    auto active = rig.app.runtime().activeErrors();
+    REQUIRE(active.size() == 1);
+    CHECK_THAT(active[0], Catch::Contains("bounces 2 needs `albedo` and `normal` bound (voxelize.albedo, voxelize.normal)"));
+
+    text = rasterPipeline(2);
+    const std::string indirect = R"(,
+                    "indirect": "cone_trace.indirect"},)";
+    REQUIRE(text.find(indirect) != std::string::npos);
+    text.replace(text.find(indirect), indirect.size(), "},");
+    text.replace(text.find(R"("pcf": 3)"), 8, R"("pcf": 3, "lamp_model": "traced")");
+    rig.load(text, {"composite.hdr"});
+    rig.app.frame();
+    active = rig.app.runtime().activeErrors();
+    REQUIRE(active.size() == 1);
+    CHECK_THAT(active[0], Catch::Contains("lamp_model traced reads the lamp from `indirect`"));
+
+    rig.load(rasterPipeline(2), {"composite.hdr"});
+    rig.app.frame();
+    rig.checkNoErrors();
+}
