@@ -144,8 +144,13 @@ std::optional<Options> parseOptions(int argc, char** argv, std::string& error) {
             auto v = value(a);
             if (!v) return std::nullopt;
             long long n = 0;
-            if (!parseInt(*v, n) || n < (a == "--frames" ? 1 : 0)) {
-                error = std::string(a) + " " + *v + ": expected a " + (a == "--frames" ? "positive" : "non-negative") + " integer";
+            // Bounded where the value lands: frames in an int, the seed in 63 bits (parseInt's
+            // range), so nothing wraps into another number.
+            constexpr long long kMaxFrames = 1'000'000'000;
+            const bool frames = a == "--frames";
+            if (!parseInt(*v, n) || n < (frames ? 1 : 0) || (frames && n > kMaxFrames)) {
+                error = std::string(a) + " " + *v + ": expected " +
+                        (frames ? "a whole number of frames from 1 to " + std::to_string(kMaxFrames) : std::string("a non-negative integer"));
                 return std::nullopt;
             }
             if (a == "--frames") o.frames = static_cast<int>(n); else o.seed = static_cast<uint64_t>(n);

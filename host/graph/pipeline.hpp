@@ -77,6 +77,10 @@ struct PipelineDesc {
 
 // Reads a pipeline. Errors: JSON syntax (file:line:col), duplicate keys, unknown keys
 // (with the nearest known key), values of the wrong JSON type. All are collected.
+// The largest pipeline file read (as a scene file: sim's kMaxSceneFileBytes); a larger
+// one, or /dev/zero, is refused by name before it fills memory.
+inline constexpr size_t kMaxPipelineFileBytes = size_t(16) << 20;
+
 Result<PipelineDesc> parsePipeline(const std::string& text, const std::string& fileName);
 
 // Writes a pipeline back as pretty JSON (2-space indent, keys in the canonical

@@ -47,19 +47,12 @@ bool Runtime::init(const RuntimeOptions& options, std::string& error) {
 }
 
 bool Runtime::loadPipeline(const fs::path& file, std::string& errors) {
-    std::error_code ec;
-    if (fs::is_directory(file, ec)) {
-        errors = file.string() + ": is a directory, not a pipeline file";
+    std::string text, why;
+    if (!json_text::readBoundedFile(file, graph::kMaxPipelineFileBytes, "pipeline file", text, why)) {
+        errors = file.string() + ": " + why;
         return false;
     }
-    std::ifstream in(file, std::ios::binary);
-    if (!in) {
-        errors = file.string() + ": cannot read pipeline file";
-        return false;
-    }
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return loadPipelineText(ss.str(), file.string(), errors);
+    return loadPipelineText(text, file.string(), errors);
 }
 
 bool Runtime::loadPipelineText(const std::string& text, const std::string& displayName, std::string& errors) {

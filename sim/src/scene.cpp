@@ -459,25 +459,12 @@ SceneResult parseSceneText(const std::string& text) {
 
 SceneResult loadSceneFile(const std::string& path) {
     SceneResult r;
-    std::error_code ec;
-    if (std::filesystem::is_directory(path, ec)) {
-        r.error = {"", "is a directory, not a scene file"};
+    std::string text, why;
+    if (!json_text::readBoundedFile(path, kMaxSceneFileBytes, "scene file", text, why)) {
+        r.error = {"", why};
         return r;
     }
-    const auto size = std::filesystem::file_size(path, ec);
-    if (!ec && size > kMaxSceneFileBytes) {
-        r.error = {"", "the file is " + std::to_string(size) + " bytes, more than the limit of " +
-                           std::to_string(kMaxSceneFileBytes)};
-        return r;
-    }
-    std::ifstream in(path, std::ios::binary);
-    if (!in) {
-        r.error = {"", "cannot read the scene file"};
-        return r;
-    }
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return parseSceneText(ss.str());
+    return parseSceneText(text);
 }
 
 bool loadScene(const std::string& path, Scene& out, std::string& error) {

@@ -72,7 +72,7 @@ void check(const Case& c) {
 
 TEST_CASE("bad command-line values", "[integration][cli][robust]") {
     for (const char* args : {"--size 0x0", "--size -5x5", "--size 100000x100000", "--size 12", "--size", "--frames -3",
-                             "--frames", "--frames 1x", "--bogus", "--pipeline", "--seed banana",
+                             "--frames", "--frames 1x", "--frames 4294967297", "--frames 2147483648", "--frames 99999999999999999999", "--bogus", "--pipeline", "--seed banana",
                              "--budget -1", "--budget fast", "--budget", "--ui-probe"}) {
         const Run r = runKiln(std::string("--headless ") + args, 60);
         INFO(args << "\n" << r.err);
@@ -85,8 +85,14 @@ TEST_CASE("bad command-line values", "[integration][cli][robust]") {
 TEST_CASE("bad pipeline files", "[integration][robust]") {
     const std::vector<Case> cases = {
         {"pipeline-missing", [](const fs::path& d) { return "--pipeline " + (d / "none.json").string(); },
-         "none.json: cannot read pipeline file"},
+         "none.json: cannot read the pipeline file"},
         {"pipeline-directory", [](const fs::path& d) { return "--pipeline " + d.string(); }, "is a directory"},
+        // Never-ending and oversized files are refused without reading them whole.
+        {"pipeline-device", [](const fs::path&) { return std::string("--pipeline /dev/zero"); },
+         "/dev/zero: is not a regular file (a device, a pipe or a socket), not a pipeline file"},
+        {"pipeline-huge", [](const fs::path& d) {
+             write(d / "h.json", std::string((16u << 20) + 1, ' ')); return "--pipeline " + (d / "h.json").string(); },
+         "h.json: the pipeline file holds more than 16777216 bytes, the limit"},
         {"pipeline-garbage", [](const fs::path& d) { write(d / "g.json", garbage(4096)); return "--pipeline " + (d / "g.json").string(); },
          "g.json:1:1: syntax error"},
         {"pipeline-empty", [](const fs::path& d) { write(d / "e.json", ""); return "--pipeline " + (d / "e.json").string(); },
@@ -112,6 +118,10 @@ TEST_CASE("bad scene files", "[integration][robust]") {
         {"scene-missing", [](const fs::path& d) { return "--scene " + (d / "none.json").string(); },
          "none.json: cannot read the scene file"},
         {"scene-directory", [](const fs::path& d) { return "--scene " + d.string(); }, "is a directory, not a scene file"},
+        {"scene-device", [](const fs::path&) { return std::string("--scene /dev/zero"); },
+         "/dev/zero: is not a regular file (a device, a pipe or a socket), not a scene file"},
+        {"scene-huge", scene("h.json", std::string((16u << 20) + 1, ' ')),
+         "h.json: the scene file holds more than 16777216 bytes, the limit"},
         {"scene-garbage", scene("g.json", garbage(4096)), "g.json: line 1, column 1: syntax error"},
         {"scene-overflow", scene("o.json", R"({"tumblers": [], "physics": {"dt": 1e999}})"),
          "o.json: physics.dt: line 1, column 36: number overflow parsing '1e999'"},

@@ -1,11 +1,15 @@
 // kiln/json_text.hpp — what the JSON loaders (pipeline files in host/graph, scene files
 // in sim/) need from the raw text before and beside nlohmann's parser: where a byte is
-// (line and column, for messages) and whether the nesting stays bounded. Header-only and
-// GL-free, so the simulation library can use it without depending on the host.
+// (line and column, for messages), whether the nesting stays bounded, and the text itself
+// read with a bound. Header-only and GL-free, so the simulation library can use it
+// without depending on the host.
 #pragma once
 
 #include <algorithm>
 #include <cstddef>
+#include <filesystem>
+#include <fstream>
+#include <string>
 #include <string_view>
 
 namespace kiln::json_text {
@@ -40,6 +44,27 @@ inline size_t firstTooDeep(std::string_view text, int maxDepth) {
         }
     }
     return std::string_view::npos;
+}
+
+// Reads the file at `path` into `text`, at most `maxBytes` of it: a directory, a device or
+// a pipe (/dev/zero, which never ends) is refused by what it is, and a file that holds
+// more than the bound by its size, without reading past it. On failure `error` says why,
+// calling the file `what` ("scene file"), without its path: the caller names the file.
+inline bool readBoundedFile(const std::filesystem::path& path, size_t maxBytes, const std::string& what,
+                            std::string& text, std::string& error) {
+    std::error_code ec;
+    const auto status = std::filesystem::status(path, ec);
+    if (!ec && std::filesystem::is_directory(status)) return error = "is a directory, not a " + what, false;
+    if (!ec && !std::filesystem::is_regular_file(status))
+        return error = "is not a regular file (a device, a pipe or a socket), not a " + what, false;
+    std::ifstream in(path, std::ios::binary);
+    if (ec || !in) return error = "cannot read the " + what, false;
+    text.assign(maxBytes + 1, '\0');
+    in.read(text.data(), std::streamsize(text.size()));
+    text.resize(size_t(in.gcount()));
+    if (text.size() > maxBytes)
+        return error = "the " + what + " holds more than " + std::to_string(maxBytes) + " bytes, the limit", false;
+    return true;
 }
 
 }  // namespace kiln::json_text
