@@ -63,7 +63,7 @@ bool FileWatcher::watch(const fs::path& dirIn) {
     return true;
 }
 
-void FileWatcher::addDirectory(const fs::path& dir) {
+void FileWatcher::addDirectory(const fs::path& dir, bool firstSight) {
     std::error_code ec;
     if (fd_ >= 0) {
         const uint32_t mask = IN_CLOSE_WRITE | IN_MOVED_TO | IN_CREATE | IN_DELETE | IN_DELETE_SELF | IN_MOVE_SELF;
@@ -72,7 +72,9 @@ void FileWatcher::addDirectory(const fs::path& dir) {
     }
     for (auto& entry : fs::directory_iterator(dir, ec)) {
         if (entry.is_directory(ec)) {
-            addDirectory(entry.path());
+            addDirectory(entry.path(), firstSight);
+        } else if (!firstSight && entry.is_regular_file(ec)) {
+            noteEvent(entry.path());
         } else if (entry.is_regular_file(ec) && !isNoise(entry.path().filename().string())) {
             bool ok = false;
             Known k;
@@ -83,6 +85,12 @@ void FileWatcher::addDirectory(const fs::path& dir) {
             if (ok) known_[entry.path()] = k;
         }
     }
+}
+
+bool FileWatcher::isWatched(const fs::path& dir) const {
+    for (auto& [wd, watched] : watches_)
+        if (watched == dir) return true;
+    return false;
 }
 
 void FileWatcher::noteEvent(const fs::path& file) {
@@ -139,6 +147,17 @@ std::vector<fs::path> FileWatcher::poll() {
                 }
                 // IN_CREATE alone may be a half-written file: wait for CLOSE_WRITE.
                 if (e->mask & (IN_CLOSE_WRITE | IN_MOVED_TO)) noteEvent(path);
+            }
+        }
+        // A root has no parent watch to announce its return (shaders/ deleted and
+        // checked out again): look for it while it is gone.
+        if (Clock::now() - lastRootCheck_ > std::chrono::milliseconds(250)) {
+            lastRootCheck_ = Clock::now();
+            for (const fs::path& root : roots_) {
+                std::error_code ec;
+                if (isWatched(root) || !fs::is_directory(root, ec)) continue;
+                log::info("file watcher: ", root.string(), " is back; watching it again");
+                addDirectory(root, false);
             }
         }
     } else if (Clock::now() - lastScan_ > std::chrono::milliseconds(100)) {

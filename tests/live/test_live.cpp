@@ -306,3 +306,23 @@ TEST_CASE("ten saves in a burst cause one reload", "[live][gl]") {
     }
     CHECK(box.app.live().shaderReloads == 1);
 }
+
+TEST_CASE("shaders/ deleted and checked out again is watched again: its changed files reload", "[live][gl]") {
+    // What `git checkout` of another branch does to a watched root: the directory goes,
+    // and a new one with other contents takes its place. The watcher had no parent
+    // watch to see it come back; it now looks for a missing root every 250 ms, and
+    // compares each file with what it held before.
+    Sandbox box("rewatch-root");
+    const fs::path shaders = box.root / "shaders", away = box.root / "shaders-away";
+    const fs::path composite = shaders / "composite/composite.frag";
+    const std::string original = slurp(composite);
+    fs::rename(shaders, away);
+    for (int i = 0; i < 5; ++i) box.app.frame();  // the watcher sees it go
+    fs::create_directories(shaders);
+    fs::copy(away, shaders, fs::copy_options::recursive);
+    writeInPlace(composite, forcedComposite(original, "vec3(0.0, 1.0, 0.0)"));
+    CHECK(box.waitFor([&] { return near(box.centre(), {0, 1, 0}); }));
+    // Watched for good: the next save lands too.
+    writeByRename(composite, forcedComposite(original, "vec3(1.0, 0.0, 0.0)"));
+    CHECK(box.waitFor([&] { return near(box.centre(), {1, 0, 0}); }));
+}

@@ -7,7 +7,8 @@
 // if its content changed (FNV-1a of the bytes), so a burst of saves is one reload
 // and a touch is none. Editor noise (.swp, 4913, *~, dot-files) is ignored. On queue
 // overflow every known file is re-hashed; a directory deleted and recreated (git
-// checkout) is re-added. Where inotify cannot be used, the same interface polls
+// checkout) is re-added — a watched root too (checked every 250 ms while it is gone),
+// its files then compared with what they held before it went. Where inotify cannot be used, the same interface polls
 // (nanosecond mtime + size + inode) at most every 100 ms.
 #pragma once
 
@@ -42,7 +43,10 @@ private:
         uintmax_t size = 0;
         uint64_t inode = 0;
     };
-    void addDirectory(const std::filesystem::path& dir);
+    // Watches `dir` recursively. firstSight: its files' contents are the baseline; else
+    // (a root that came back) each file is an event, reported if its content changed.
+    void addDirectory(const std::filesystem::path& dir, bool firstSight = true);
+    bool isWatched(const std::filesystem::path& dir) const;
     void noteEvent(const std::filesystem::path& file);
     void rescan();
     static bool isNoise(const std::string& name);
@@ -54,6 +58,7 @@ private:
     std::map<std::filesystem::path, Known> known_;  // every file seen, by content hash
     std::map<std::filesystem::path, Clock::time_point> pending_;  // path → last event
     Clock::time_point lastScan_{};
+    Clock::time_point lastRootCheck_{};
 };
 
 }  // namespace kiln
