@@ -20,7 +20,7 @@ using namespace kiln::app;
 namespace {
 
 int fail(const std::string& message) {
-    std::fprintf(stderr, "kiln: error: %s\n", message.c_str());
+    log::error(message);  // every line prefixed
     return 1;
 }
 

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -65,6 +66,10 @@ void check(const Case& c) {
     CHECK_THAT(line, Catch::Contains(c.expect));
     CHECK(line.size() < 400);
     CHECK(r.err.find("GL [") == std::string::npos);  // no GL error on the way
+    // Every line says what it is, continuation lines of a shader's log included.
+    std::istringstream lines(r.err);
+    for (std::string l; std::getline(lines, l);)
+        if (!l.empty()) CHECK_THAT(l, Catch::StartsWith("kiln: "));
     fs::remove_all(dir);
 }
 
