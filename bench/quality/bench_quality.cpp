@@ -74,7 +74,8 @@ namespace {
 
 // The documented subset swept when no --sweep is given: the knobs the seed's report
 // discusses (voxel resolution, aperture, step schedule, trace stride) and the shadow
-// filter and map size, the indirect output's size, the lamp's quadrature. The mips and
+// filter and map size, the indirect output's size, the lamp's model and its vertices
+// or points, the diffuse bounces. The mips and
 // the cone set change bindings, so they are whole pipelines (--also
 // pipelines/iso_mips.json, pipelines/normal_cones.json; sweep cone_trace.cones with
 // --pipeline pipelines/normal_cones.json).
@@ -83,6 +84,7 @@ const char* const kDefaultSweeps[] = {
     "cone_trace.aperture=30,45,60,90", "cone_trace.schedule=octave,continuous", "cone_trace.trace_stride=1,2,4",
     "composite.pcf=1,3,5,9",          "shadow.size=512,1024,2048,4096",
     "cone_trace.output_divisor=1,2",  "composite.lamp_samples=8,16,32",
+    "voxel_mip.bounces=1,2,3",        "composite.lamp_model=traced,contour,points",
 };
 
 struct Args {
