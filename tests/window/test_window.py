@@ -29,14 +29,19 @@ def sh(*args):
     return subprocess.run(args, check=True, capture_output=True, text=True).stdout
 
 
-def probe():
-    for _ in range(50):
+def probe(timeout=60):
+    # A deadline, not a count of tries: on a loaded machine the window's first frames
+    # (shader compiles on llvmpipe) took longer than the 5 s this once allowed.
+    deadline = time.time() + timeout
+    while time.time() < deadline:
+        if kiln.poll() is not None:
+            raise RuntimeError("kiln exited before writing its probe file")
         try:
             with open(PROBE) as f:
                 return json.load(f)
         except (OSError, ValueError):
             time.sleep(0.1)
-    raise RuntimeError("no probe file")
+    raise RuntimeError("no probe file after %d s" % timeout)
 
 
 def wait_for(predicate, what, timeout=60):
