@@ -2,7 +2,10 @@
 // N cones over the hemisphere of the G-buffer normal march through the mipped voxel
 // radiance with quadrilinear lookups; steps grow with the cone diameter. Output: the
 // indirect irradiance as a cosine-weighted mean incoming radiance (composite adds
-// albedo × rgb), a = ambient visibility (cone-traced AO).
+// albedo × rgb), a = ambient visibility (cone-traced AO), or with `lamp` the lamp's
+// unshadowed projected solid angle at the traced surface (shaders/common/light.glsl's
+// contour), upsampled with the indirect light for composite's lamp_model traced: smooth
+// on a surface like the indirect light, so a sixteenth of the pixels carry it.
 //
 // Cone sets (tangent frame, z = normal; weights sum to 1):
 //   1   the normal.
