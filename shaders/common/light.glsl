@@ -178,26 +178,22 @@ float lampProjectedSolidAngle(vec3 p, vec3 n) {
     // below it is cut where it crosses (the crossing replaces that end). The region is
     // the projection of a convex body, so it crosses at most once each way: one edge
     // along the horizon joins the exit to the entry. Branch-free (llvmpipe runs both
-    // sides of a branch): one Lambert term per vertex. The loop closes on the last
-    // vertex, so the walk starts there.
+    // sides of a branch): one Lambert term per vertex; the last edge closes the loop on
+    // the first vertex.
     OutlineWalk walk = startArc(o.phiStart, o.phiSpan / float(o.rimCount > 0 ? o.tangentCount - 1 : o.tangentCount));
-    vec3 lastVertex;
-    if (o.rimCount > 0) {
-        bool closes = o.tangentCount > 0;
-        float step = o.thetaSpan / float(closes ? o.rimCount + 1 : o.rimCount);
-        float theta = o.thetaStart + step * float(closes ? o.rimCount : o.rimCount - 1);
-        lastVertex = o.rimCentre + o.rimRadius * sqrt(abs(step) / sin(abs(step))) * vec3(cos(theta), 0.0, sin(theta));
-    } else {
-        lastVertex = circlePoint(o.tangentCentre, o.tangentU, o.tangentV, o.tangentRadius * walk.grow,
-                                 o.phiStart - o.phiSpan / float(o.tangentCount));
-    }
-    vec3 previous = normalize(lastVertex - p);
-    float dPrevious = dot(n, previous);
+    const vec3 first = normalize(nextOutlineVertex(o, 0, walk) - p);
+    const float dFirst = dot(n, first);
+    vec3 previous = first;
+    float dPrevious = dFirst;
     vec3 exit = vec3(0.0), entry = vec3(0.0);
     float sum = 0.0;
-    for (int i = 0; i < count; ++i) {  // every case has `count` vertices in all
-        vec3 current = normalize(nextOutlineVertex(o, i, walk) - p);
-        float dCurrent = dot(n, current);
+    for (int i = 1; i <= count; ++i) {  // every case has `count` vertices in all
+        vec3 current = first;
+        float dCurrent = dFirst;
+        if (i < count) {
+            current = normalize(nextOutlineVertex(o, i, walk) - p);
+            dCurrent = dot(n, current);
+        }
         bool aboveA = dPrevious >= 0.0, aboveB = dCurrent >= 0.0;
         vec3 crossing = normalize((dPrevious * current - dCurrent * previous) / (aboveA == aboveB ? 1.0 : dPrevious - dCurrent));
         exit = aboveA && !aboveB ? crossing : exit;
