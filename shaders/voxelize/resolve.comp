@@ -6,22 +6,10 @@
 // emission.
 layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
 
-layout(r32ui, binding = 0) uniform readonly uimage3D u_sumR;
-layout(r32ui, binding = 1) uniform readonly uimage3D u_sumG;
-layout(r32ui, binding = 2) uniform readonly uimage3D u_sumB;
-layout(r32ui, binding = 3) uniform readonly uimage3D u_count;
-layout(r32ui, binding = 4) uniform readonly uimage3D u_albedoR;
-layout(r32ui, binding = 5) uniform readonly uimage3D u_albedoG;
-layout(r32ui, binding = 6) uniform readonly uimage3D u_albedoB;
-layout(r32i, binding = 7) uniform readonly iimage3D u_normalX;
-layout(r32i, binding = 8) uniform readonly iimage3D u_normalY;
-layout(r32i, binding = 9) uniform readonly iimage3D u_normalZ;
+#include "sums.glsl"  // the accumulators (image units 0–9) and their fixed-point scales
 layout(rgba16f, binding = 10) uniform writeonly image3D u_radiance;
 layout(rgba8, binding = 11) uniform writeonly image3D u_albedo;
 layout(rgba16f, binding = 12) uniform writeonly image3D u_normal;
-
-const float kFixedScale = 512.0;  // keep in sync with sums.glsl
-const float kUnitScale = 4096.0;
 
 void main() {
     ivec3 v = ivec3(gl_GlobalInvocationID);

@@ -1,7 +1,7 @@
 // The voxelization's accumulators (passes/voxelize/voxelize.cpp, step 3): fixed-point
 // radiance sums and a fragment count per voxel, added to atomically by the rasterized
 // fragments (voxelize.frag) and the splatted particles (splat.comp); resolve.comp
-// divides them. Surfaces (not the particles, which only emit) also add their albedo and
+// (which includes this file for the same layout and scales) divides them. Surfaces (not the particles, which only emit) also add their albedo and
 // normal: what voxel_mip's bounces reflect, and towards where.
 layout(r32ui, binding = 0) uniform coherent uimage3D u_sumR;
 layout(r32ui, binding = 1) uniform coherent uimage3D u_sumG;
@@ -14,7 +14,7 @@ layout(r32i, binding = 7) uniform coherent iimage3D u_normalX;
 layout(r32i, binding = 8) uniform coherent iimage3D u_normalY;
 layout(r32i, binding = 9) uniform coherent iimage3D u_normalZ;
 
-const float kFixedScale = 512.0;   // keep in sync with resolve.comp
+const float kFixedScale = 512.0;
 const float kMaxRadiance = 2048.0;
 const float kUnitScale = 4096.0;   // albedo and normal components (|x| ≤ 1): 2^19 fragments a voxel before overflow
 
