@@ -27,6 +27,12 @@ const int kBlock = KILN_GATHER_BLOCK;
 
 bool reflects(vec4 radiance, vec3 albedo) { return radiance.a > 0.0 && max(albedo.r, max(albedo.g, albedo.b)) > 0.0; }
 
+// Voxel i (0 … kBlock³ − 1) of a block.
+ivec3 voxelOf(ivec3 block, int i) { return block * kBlock + ivec3(i % kBlock, (i / kBlock) % kBlock, i / (kBlock * kBlock)); }
+
+// The weight of cone direction d for surfaces of mean normal direction n and |m| = facing.
+float coneWeight(vec3 n, float facing, vec3 d) { return facing * max(dot(n, d), 0.0) + (1.0 - facing) * 0.25; }
+
 void main() {
     ivec3 block = ivec3(gl_GlobalInvocationID);
     int res = int(u_voxelRes);
@@ -35,7 +41,7 @@ void main() {
     vec3 normalSum = vec3(0.0), centreSum = vec3(0.0);
     float surfaces = 0.0;
     for (int i = 0; i < kBlock * kBlock * kBlock; ++i) {
-        ivec3 v = block * kBlock + ivec3(i % kBlock, (i / kBlock) % kBlock, i / (kBlock * kBlock));
+        ivec3 v = voxelOf(block, i);
         if (!reflects(texelFetch(u_emitted, v, 0), texelFetch(u_albedo, v, 0).rgb)) continue;
         normalSum += texelFetch(u_normal, v, 0).xyz;
         centreSum += (vec3(v) + 0.5) / u_voxelRes * 2.0 - 1.0;
@@ -52,13 +58,13 @@ void main() {
         // trace 4 cones, not 12).
         uint cones = 0u;
         for (int t = 0; t < kFixedConeTiles; ++t)
-            if (facing * max(dot(n, fixedConeDirection(t)), 0.0) + (1.0 - facing) * 0.25 >= 1e-3) cones |= 1u << t;
+            if (coneWeight(n, facing, fixedConeDirection(t)) >= 1e-3) cones |= 1u << t;
         vec3 sum = vec3(0.0);
         float weights = 0.0;
         for (; cones != 0u; cones &= cones - 1u) {
             int t = findLSB(cones);
             vec3 d = fixedConeDirection(t);
-            float w = facing * max(dot(n, d), 0.0) + (1.0 - facing) * 0.25;
+            float w = coneWeight(n, facing, d);
             // Off the surfaces: along their normal, or along the cone where they face
             // every way.
             vec3 away = facing >= 0.5 ? n : d;
@@ -68,7 +74,7 @@ void main() {
         gathered = sum / max(weights, 1e-6);
     }
     for (int i = 0; i < kBlock * kBlock * kBlock; ++i) {
-        ivec3 v = block * kBlock + ivec3(i % kBlock, (i / kBlock) % kBlock, i / (kBlock * kBlock));
+        ivec3 v = voxelOf(block, i);
         vec4 radiance = texelFetch(u_emitted, v, 0);
         vec3 albedo = texelFetch(u_albedo, v, 0).rgb;
         if (reflects(radiance, albedo)) radiance.rgb += albedo * gathered * radiance.a;
