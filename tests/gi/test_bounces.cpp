@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "gi/rig.hpp"
+#include "metrics.hpp"
 
 using namespace kiln;
 using namespace kiln::test;
@@ -37,20 +38,6 @@ std::string rasterPipeline(int bounces, const std::string& mode = "fixed_cones")
          "params": {"pcf": 3, "lamp_samples": 16}})");
 }
 
-// Mean Rec. 709 luminance over the pixels `keep` marks (all when empty).
-double meanLuminance(const FloatImage& img, const std::vector<bool>& keep = {}) {
-    double sum = 0.0;
-    int counted = 0;
-    for (int y = 0; y < img.height; ++y)
-        for (int x = 0; x < img.width; ++x) {
-            if (!keep.empty() && !keep[size_t(y) * img.width + x]) continue;
-            const float* c = img.at(x, y);
-            sum += 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
-            ++counted;
-        }
-    return sum / std::max(counted, 1);
-}
-
 FloatImage rasterFrame(Rig& rig, int bounces, const std::string& mode = "fixed_cones") {
     rig.load(rasterPipeline(bounces, mode), {"composite.hdr", "gbuffer.emissive"});
     rig.app.frame();
@@ -59,9 +46,9 @@ FloatImage rasterFrame(Rig& rig, int bounces, const std::string& mode = "fixed_c
 }
 
 // Pixels that show no emitter (their radiance is copied, not computed).
-std::vector<bool> notEmissive(Rig& rig) {
+metrics::Mask notEmissive(Rig& rig) {
     const FloatImage glow = rig.image("gbuffer", "emissive");
-    std::vector<bool> keep(size_t(glow.width) * glow.height);
+    metrics::Mask keep(size_t(glow.width) * glow.height);
     for (int y = 0; y < glow.height; ++y)
         for (int x = 0; x < glow.width; ++x) {
             const float* e = glow.at(x, y);
@@ -92,7 +79,7 @@ TEST_CASE("voxel_mip bounces: the white furnace — k bounces show 2 − 0.5^k o
     rig.app.camera().distance = 0.5f;  // inside the box
     double previous = 1.0;             // emission alone
     for (int k = 1; k <= 4; ++k) {
-        const double mean = meanLuminance(rasterFrame(rig, k, mode));
+        const double mean = metrics::meanLuminance(rasterFrame(rig, k, mode));
         const double expected = 2.0 - std::pow(0.5, k);
         INFO(mode << ", bounces " << k << ": mean radiance " << mean << ", expected " << expected);
         CHECK(std::abs(mean - expected) < 0.02 * expected);
@@ -121,13 +108,13 @@ TEST_CASE("voxel_mip bounces: each bounce adds what the path tracer's next path 
     double previousRaster = 0.0, previousReference = 0.0;
     for (int k = 1; k <= 3; ++k) {
         const FloatImage frame = rasterFrame(rig, k);
-        const std::vector<bool> lit = notEmissive(rig);
+        const metrics::Mask lit = notEmissive(rig);
         rig.load(pipeline("reference.radiance", R"({"id": "reference", "module": "reference",
                  "params": {"samples_per_frame": 64, "max_bounces": )" + std::to_string(k + 1) + "}}"));
         for (int f = 0; f < 4; ++f) rig.app.frame();
         rig.checkNoErrors();
-        const double reference = meanLuminance(rig.image("reference", "radiance"), lit);
-        const double raster = meanLuminance(frame, lit);
+        const double reference = metrics::meanLuminance(rig.image("reference", "radiance"), lit);
+        const double raster = metrics::meanLuminance(frame, lit);
         INFO("bounces " << k << ": raster " << raster << ", reference " << reference << " (ratio " << raster / reference
                         << ")");
         CHECK(std::abs(raster / reference - 1.0) < 0.10);
