@@ -8,6 +8,7 @@
 #include <vector>
 
 #include <catch2/catch.hpp>
+#include <glm/glm.hpp>
 
 #include "app/app.hpp"
 #include "kiln/image_io.hpp"
@@ -72,6 +73,14 @@ struct Rig {
         for (auto& e : app.runtime().activeErrors()) FAIL(e);
     }
 };
+
+// World position of pixel (x, y) from a G-buffer depth image and the rig's camera.
+inline glm::vec3 worldOf(Rig& rig, const FloatImage& depth, int x, int y) {
+    const glm::mat4 inv = glm::inverse(rig.app.camera().projection(1.0f) * rig.app.camera().view());
+    glm::vec4 ndc((x + 0.5f) / rig.size * 2 - 1, (y + 0.5f) / rig.size * 2 - 1, depth.at(x, y)[0] * 2 - 1, 1);
+    glm::vec4 w = inv * ndc;
+    return glm::vec3(w) / w.w;
+}
 
 inline std::string pipeline(const std::string& output, const std::string& passes) {
     return R"({"output": ")" + output + R"(", "passes": [)" + passes + "]}";

@@ -63,14 +63,6 @@ std::vector<glm::vec3> fixedConeDirections() {
     return dirs;
 }
 
-// World position of a pixel from the G-buffer depth and the rig's camera.
-glm::vec3 worldOf(Rig& rig, const FloatImage& depth, int x, int y) {
-    const glm::mat4 inv = glm::inverse(rig.app.camera().projection(1.0f) * rig.app.camera().view());
-    glm::vec4 ndc((x + 0.5f) / rig.size * 2 - 1, (y + 0.5f) / rig.size * 2 - 1, depth.at(x, y)[0] * 2 - 1, 1);
-    glm::vec4 w = inv * ndc;
-    return glm::vec3(w) / w.w;
-}
-
 float luminance(const float* c) { return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]; }
 
 // The shipped scene 1 s in (the fire's particles spawned), `passes` (a voxelize among

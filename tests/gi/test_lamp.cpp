@@ -216,14 +216,12 @@ TEST_CASE("lamp: traced at one pixel in 4×4 and upsampled, the lamp's light sta
     };
     const FloatImage traced = direct("traced"), perPixel = direct("contour");
     const FloatImage depth = rig.image("gbuffer", "depth");
-    const glm::mat4 inv = glm::inverse(rig.app.camera().projection(1.0f) * rig.app.camera().view());
     double sumTraced = 0.0, sumPixel = 0.0;
     int near = 0, nearEqual = 0;
     for (int y = 0; y < traced.height; ++y)
         for (int x = 0; x < traced.width; ++x) {
             sumTraced += traced.at(x, y)[1], sumPixel += perPixel.at(x, y)[1];
-            glm::vec4 w = inv * glm::vec4((x + 0.5f) / 96 * 2 - 1, (y + 0.5f) / 96 * 2 - 1, depth.at(x, y)[0] * 2 - 1, 1);
-            const glm::vec3 p = glm::vec3(w) / w.w;
+            const glm::vec3 p = test::worldOf(rig, depth, x, y);
             // Inside the near field with a margin for the depth's rounding.
             if (depth.at(x, y)[0] < 1.0f && glm::distance(p, glm::vec3(kLampCentre)) < kLampRadius + 0.19) {
                 ++near;
