@@ -2,23 +2,37 @@
 
 #include <dlfcn.h>
 #include <elf.h>
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <cstring>
 #include <fstream>
+#include <optional>
+#include <string_view>
+#include <thread>
+#include <vector>
 
-#include "kiln/names.hpp"
+#include "kiln/guard.hpp"
 #include "kiln/log.hpp"
+#include "kiln/names.hpp"
 
 namespace fs = std::filesystem;
 
 namespace kiln {
 
 LoadedModule::~LoadedModule() {
-    if (handle_) dlclose(handle_);
+    if (handle_ && !faulted()) dlclose(handle_);
     std::error_code ec;
     if (!loadedCopy_.empty()) fs::remove(loadedCopy_, ec);
+}
+
+void LoadedModule::markFaulted(std::string message) {
+    if (fault_.empty()) fault_ = std::move(message);
 }
 
 ModuleLoader::ModuleLoader(std::vector<fs::path> dirs) : dirs_(std::move(dirs)) {
@@ -70,6 +84,8 @@ std::string joined(const std::vector<std::string>& v) {
 // build, `truncate`) then faults with SIGBUS on first touch, inside dlopen. So the
 // headers are checked against the file's real size first: a 64-bit ELF shared object
 // whose program headers, loadable segments and section headers all lie inside it.
+bool checkDynamicSection(std::ifstream& in, const Elf64_Ehdr& eh, uint64_t size, std::string& error);
+
 bool checkElf(const fs::path& file, std::string& error) {
     std::ifstream in(file, std::ios::binary);
     std::error_code ec;
@@ -103,7 +119,102 @@ bool checkElf(const fs::path& file, std::string& error) {
             return false;
         }
     }
+    return checkDynamicSection(in, eh, size, error);
+}
+
+// What a linker leaves mid-write can have every header right and a body of zeros.
+// dlopen reads the dynamic section first; it must hold the string and symbol tables,
+// and the strings must name the entry point.
+bool checkDynamicSection(std::ifstream& in, const Elf64_Ehdr& eh, uint64_t size, std::string& error) {
+    std::vector<Elf64_Phdr> headers(eh.e_phnum);
+    in.clear();
+    in.seekg(static_cast<std::streamoff>(eh.e_phoff));
+    if (!in.read(reinterpret_cast<char*>(headers.data()), std::streamsize(headers.size() * sizeof(Elf64_Phdr)))) {
+        error = "unreadable program headers";
+        return false;
+    }
+    auto dynamic = std::find_if(headers.begin(), headers.end(), [](const Elf64_Phdr& p) { return p.p_type == PT_DYNAMIC; });
+    if (dynamic == headers.end() || dynamic->p_filesz < sizeof(Elf64_Dyn) || dynamic->p_offset > size ||
+        dynamic->p_filesz > size - dynamic->p_offset) {
+        error = "no dynamic section inside the file";
+        return false;
+    }
+    std::vector<Elf64_Dyn> entries(dynamic->p_filesz / sizeof(Elf64_Dyn));
+    in.seekg(static_cast<std::streamoff>(dynamic->p_offset));
+    in.read(reinterpret_cast<char*>(entries.data()), std::streamsize(entries.size() * sizeof(Elf64_Dyn)));
+    uint64_t strtab = 0, strsz = 0;
+    bool symtab = false, hash = false;
+    for (const Elf64_Dyn& d : entries) {
+        if (d.d_tag == DT_NULL) break;
+        if (d.d_tag == DT_STRTAB) strtab = d.d_un.d_ptr;
+        if (d.d_tag == DT_STRSZ) strsz = d.d_un.d_val;
+        if (d.d_tag == DT_SYMTAB) symtab = true;
+        if (d.d_tag == DT_HASH || d.d_tag == DT_GNU_HASH) hash = true;
+    }
+    const std::string written = " (a file still being written, or overwritten with zeros?)";
+    if (!strtab || !strsz || !symtab || !hash) {
+        error = "its dynamic section lacks the symbol tables" + written;
+        return false;
+    }
+    // The string table's address to a file offset, through the segment that maps it.
+    auto segment = std::find_if(headers.begin(), headers.end(), [&](const Elf64_Phdr& p) {
+        return p.p_type == PT_LOAD && strtab >= p.p_vaddr && strtab + strsz <= p.p_vaddr + p.p_filesz;
+    });
+    if (segment == headers.end() || strsz > (64u << 20)) {
+        error = "its dynamic string table lies outside the file" + written;
+        return false;
+    }
+    std::string strings(strsz, '\0');
+    in.seekg(static_cast<std::streamoff>(segment->p_offset + (strtab - segment->p_vaddr)));
+    if (!in.read(strings.data(), std::streamsize(strsz)) ||
+        strings.find(std::string_view("kiln_pass_module\0", 17)) == std::string::npos) {
+        error = "not a Kiln pass module (no exported symbol kiln_pass_module)";
+        return false;
+    }
     return true;
+}
+
+// Runs what dlopen runs — the library's static initialisers — and its entry point in a
+// child process, where a crash or a hang costs nothing: the host learns the signal and
+// never maps the library. Returns the fault, or nothing when the child came back (an
+// ordinary dlopen error is left for the host's own dlopen to report).
+constexpr int kThrewStatus = 3;
+
+std::optional<std::string> trialOpen(const fs::path& file) {
+    const pid_t child = fork();
+    if (child < 0) return std::nullopt;  // no process to spare: the guard is what is left
+    if (child == 0) {
+        for (int sig : {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT}) signal(sig, SIG_DFL);
+        const int devnull = open("/dev/null", O_WRONLY);  // its messages are the host's to give
+        if (devnull >= 0) dup2(devnull, STDERR_FILENO), dup2(devnull, STDOUT_FILENO);
+        // Nothing may unwind out of here: the child would go on as a copy of the host.
+        try {
+            void* handle = dlopen(file.c_str(), RTLD_NOW | RTLD_LOCAL);
+            if (!handle) _exit(2);
+            using EntryFn = const KilnPassModule* (*)();
+            if (auto entry = reinterpret_cast<EntryFn>(dlsym(handle, "kiln_pass_module"))) entry();
+        } catch (...) {
+            _exit(kThrewStatus);
+        }
+        _exit(0);
+    }
+    const auto limit = guard::watchdogLimit().count() > 0 ? guard::watchdogLimit() : std::chrono::milliseconds(60000);
+    const auto deadline = std::chrono::steady_clock::now() + limit;
+    int status = 0;
+    for (auto pause = std::chrono::microseconds(200);; pause = std::min(pause * 2, std::chrono::microseconds(20000))) {
+        const pid_t done = waitpid(child, &status, WNOHANG);
+        if (done == child) break;
+        if (done < 0) return std::nullopt;
+        if (std::chrono::steady_clock::now() >= deadline) {
+            kill(child, SIGKILL);
+            waitpid(child, &status, 0);
+            return guard::overrun(limit);
+        }
+        std::this_thread::sleep_for(pause);
+    }
+    if (WIFSIGNALED(status)) return guard::signalName(WTERMSIG(status));
+    if (WIFEXITED(status) && WEXITSTATUS(status) == kThrewStatus) return std::string("an exception");
+    return std::nullopt;
 }
 }  // namespace
 
@@ -125,11 +236,13 @@ std::shared_ptr<LoadedModule> ModuleLoader::load(const std::string& name, std::s
         return nullptr;
     }
 
-    // A private copy under a name never used before: dlopen would hand back a cached
-    // handle for a path it has seen, and the linker may rewrite the original.
+    // A private copy under a name never used before in this process (not only by this
+    // loader: a faulted library stays mapped): dlopen would hand back a cached handle for
+    // a path it has seen, and the linker may rewrite the original.
+    static std::atomic<unsigned> serial{0};
     std::error_code ec;
     fs::create_directories(scratch_, ec);
-    fs::path copy = scratch_ / (fileNameFor(name) + "." + std::to_string(++serial_));
+    fs::path copy = scratch_ / (fileNameFor(name) + "." + std::to_string(++serial));
     fs::path tmp = copy;
     tmp += ".tmp";
     fs::copy_file(source, tmp, fs::copy_options::overwrite_existing, ec);
@@ -149,19 +262,36 @@ std::shared_ptr<LoadedModule> ModuleLoader::load(const std::string& name, std::s
         error = source.string() + ": cannot load: " + why;
         return nullptr;
     }
-    module->handle_ = dlopen(copy.c_str(), RTLD_NOW | RTLD_LOCAL);
-    if (!module->handle_) {
+    if (auto fault = trialOpen(copy)) {
+        error = source.string() + ": cannot load: " + *fault + " in its static initialisers or kiln_pass_module()";
+        return nullptr;
+    }
+    // The child came through; the guard is for a library that behaves otherwise here.
+    using EntryFn = const KilnPassModule* (*)();
+    const KilnPassModule* desc = nullptr;
+    bool opened = false, hasEntry = false;
+    if (auto fault = guard::guarded([&] {
+            module->handle_ = dlopen(copy.c_str(), RTLD_NOW | RTLD_LOCAL);
+            if (!module->handle_) return;
+            opened = true;
+            auto entry = reinterpret_cast<EntryFn>(dlsym(module->handle_, "kiln_pass_module"));
+            if (!entry) return;
+            hasEntry = true;
+            desc = entry();
+        })) {
+        module->markFaulted(source.string() + ": " + *fault + " in its static initialisers or kiln_pass_module()");
+        error = source.string() + ": cannot load: " + *fault + " in its static initialisers or kiln_pass_module()";
+        return nullptr;
+    }
+    if (!opened) {
         const char* why = dlerror();
         error = source.string() + ": cannot load: " + (why ? why : "dlopen failed");
         return nullptr;
     }
-    using EntryFn = const KilnPassModule* (*)();
-    auto entry = reinterpret_cast<EntryFn>(dlsym(module->handle_, "kiln_pass_module"));
-    if (!entry) {
+    if (!hasEntry) {
         error = source.string() + ": not a Kiln pass module (no exported symbol kiln_pass_module)";
         return nullptr;
     }
-    const KilnPassModule* desc = entry();
     if (!desc) {
         error = source.string() + ": kiln_pass_module() returned null";
         return nullptr;
@@ -182,13 +312,10 @@ std::shared_ptr<LoadedModule> ModuleLoader::load(const std::string& name, std::s
 
 PassPtr ModuleLoader::create(const std::shared_ptr<LoadedModule>& module, std::string& error) {
     Pass* raw = nullptr;
-    try {
-        raw = module->desc_->create();
-    } catch (const std::exception& e) {
-        error = module->source_.string() + ": factory failed: " + e.what();
-        return nullptr;
-    } catch (...) {
-        error = module->source_.string() + ": factory failed with an unknown exception";
+    if (auto fault = guard::guarded([&] { raw = module->desc_->create(); })) {
+        const std::string what = module->source_.filename().string() + ": " + *fault + " in create()";
+        if (fault->rfind("exception", 0) != 0) module->markFaulted(what);  // a throw unwound; a signal did not
+        error = module->source_.string() + ": factory failed: " + *fault + " in create()";
         return nullptr;
     }
     if (!raw) {
@@ -197,7 +324,11 @@ PassPtr ModuleLoader::create(const std::shared_ptr<LoadedModule>& module, std::s
     }
     // The deleter holds the module, so the code that destroys the pass stays mapped.
     auto destroy = module->desc_->destroy;
-    return PassPtr(raw, [module, destroy](Pass* p) { destroy(p); });
+    return PassPtr(raw, [module, destroy](Pass* p) {
+        if (module->faulted()) return;  // its code is not called again: the object is lost
+        if (auto fault = guard::guarded([&] { destroy(p); }))
+            module->markFaulted(module->source_.filename().string() + ": " + *fault + " in destroy()");
+    });
 }
 
 }  // namespace kiln

@@ -1,6 +1,6 @@
 #include "run/module_registry.hpp"
 
-#include <exception>
+#include "kiln/guard.hpp"
 
 namespace kiln::run {
 
@@ -10,11 +10,34 @@ graph::Result<ModuleRegistry::Module> ModuleRegistry::probe(const std::string& n
     if (!library) return graph::Result<Module>::failure(error);
     PassPtr object = ModuleLoader::create(library, error);
     if (!object) return graph::Result<Module>::failure(error);
-    try {
-        return Module{library, object->declare()};
-    } catch (const std::exception& e) {
-        return graph::Result<Module>::failure(library->sourcePath().string() + ": declare() threw: " + e.what());
+    PassDeclaration decl;
+    if (auto fault = guard::guarded([&] { decl = object->declare(); })) {
+        const std::string what = library->sourcePath().filename().string() + ": " + *fault + " in declare()";
+        if (fault->rfind("exception", 0) != 0) library->markFaulted(what);  // a signal did not unwind
+        return graph::Result<Module>::failure(library->sourcePath().string() + ": " + *fault + " in declare()");
     }
+    object.reset();  // destroy() is tried here too: a module that faults in it is refused now
+    if (library->takeFaultToReport())
+        return graph::Result<Module>::failure(library->sourcePath().parent_path().string() + "/" + library->fault());
+    return Module{library, std::move(decl)};
+}
+
+void ModuleRegistry::keepAsPrevious(const std::string& name, Module replaced) {
+    if (replaced.library->faulted()) previous_.erase(name);
+    else previous_[name] = std::move(replaced);
+}
+
+bool ModuleRegistry::rollBack(const std::string& name) {
+    auto it = previous_.find(name);
+    if (it == previous_.end()) return false;
+    modules_[name] = std::move(it->second);
+    previous_.erase(it);
+    return true;
+}
+
+const ModuleRegistry::Module* ModuleRegistry::previous(const std::string& name) const {
+    auto it = previous_.find(name);
+    return it == previous_.end() ? nullptr : &it->second;
 }
 
 graph::Result<PassDeclaration> ModuleRegistry::declaration(const std::string& name) {

@@ -4,12 +4,21 @@
 // directories. Names must match [a-z0-9_]+ (no path, no "..", no suffix). Every load
 // copies the file to a fresh private path first: dlopen caches by path, and a
 // rebuilt library must never be overwritten while it is mapped.
+//
+// Loading is the one call the in-process guard (kiln/guard.hpp) cannot make safe: a
+// crash in a library's static initialisers happens inside dlopen, with the dynamic
+// loader's lock held. So a copy is first checked as a file (ELF headers, segments and
+// dynamic section inside it, the entry symbol named), then opened in a child process,
+// and only then in the host. Every later call into the module (create, declare,
+// execute, destroy) runs under the guard; a module that faulted is marked, and its
+// library is never unloaded (its destructors may fault too).
 #pragma once
 
 #include <filesystem>
 #include <functional>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "kiln/pass.hpp"
@@ -26,6 +35,14 @@ public:
     const std::filesystem::path& sourcePath() const { return source_; }
     const KilnPassModule& descriptor() const { return *desc_; }
 
+    // Set when code of this library faulted: the message names the file, the fault and
+    // the entry point. A faulted library stays mapped for the rest of the run.
+    void markFaulted(std::string message);
+    bool faulted() const { return !fault_.empty(); }
+    const std::string& fault() const { return fault_; }
+    // True the first time it is asked after a fault: whoever gets true prints it.
+    bool takeFaultToReport() { return faulted() && !std::exchange(faultReported_, true); }
+
 private:
     friend class ModuleLoader;
     LoadedModule() = default;
@@ -33,10 +50,13 @@ private:
     std::filesystem::path source_, loadedCopy_;
     void* handle_ = nullptr;
     const KilnPassModule* desc_ = nullptr;
+    std::string fault_;
+    bool faultReported_ = false;
 };
 
 // A pass object that keeps its library loaded for as long as it lives, and is
-// destroyed by the library that created it.
+// destroyed by the library that created it (under the guard: a fault in destroy()
+// marks the library, for the owner to report).
 using PassPtr = std::unique_ptr<Pass, std::function<void(Pass*)>>;
 
 class ModuleLoader {
@@ -55,19 +75,20 @@ public:
     // to one line naming the file and what is wrong.
     std::shared_ptr<LoadedModule> load(const std::string& name, std::string& error);
 
-    // Creates a pass from a loaded module; null with `error` if the factory fails.
+    // Creates a pass from a loaded module; null with `error` if the factory fails or
+    // faults.
     static PassPtr create(const std::shared_ptr<LoadedModule>& module, std::string& error);
 
     const std::vector<std::filesystem::path>& dirs() const { return dirs_; }
 
     // The ELF check load() runs before dlopen: false (with `why`) for a file that is not
-    // a complete 64-bit ELF shared library — garbage, or one still being written.
+    // a complete 64-bit ELF shared library — garbage, one cut short, or one whose body
+    // is not written yet (a dynamic section without the entry symbol's name).
     static bool checkFile(const std::filesystem::path& file, std::string& why);
 
 private:
     std::vector<std::filesystem::path> dirs_;
     std::filesystem::path scratch_;  // private copies of loaded libraries
-    unsigned serial_ = 0;
 };
 
 }  // namespace kiln
