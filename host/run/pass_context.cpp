@@ -49,7 +49,10 @@ GLuint HostPassContext::program(const ProgramDesc& descIn) {
     if (desc.debugName.empty() && !desc.stages.empty()) desc.debugName = slot_.id + ":" + desc.stages.back();
     std::string error;
     const GLuint id = slot_.programs.get(shared_.shaders, desc, error);
-    if (!id) fail(error);
+    if (!id) {
+        fail(error);
+        slot_.loggedError = slot_.error;  // the program cache printed it when the build failed
+    }
     return id;
 }
 

@@ -28,6 +28,7 @@ struct PassSlot {
     ProgramCache programs;
     std::optional<std::vector<uint64_t>> lastRunKey;  // empty: run next frame
     std::string error;                                // why the last execute failed
+    std::string loggedError;                          // the last error printed (once each)
     PassTimings timings;
 
     // Forget the last run (the pass runs next frame) and, when its textures changed,

@@ -3,10 +3,12 @@
 #include <algorithm>
 #include <chrono>
 #include <fstream>
+#include <set>
 #include <sstream>
 
 #include "graph/compiler.hpp"
 #include "graph/pipeline.hpp"
+#include "kiln/guard.hpp"
 #include "kiln/log.hpp"
 
 namespace fs = std::filesystem;
@@ -24,6 +26,7 @@ Runtime::Runtime() = default;
 Runtime::~Runtime() {
     // Pass objects go before the modules whose code destroys them (PassPtr keeps its
     // module alive), and before the GL objects they might reference.
+    for (auto& slot : slots_) destroyPassObject(*slot);
     slots_.clear();
     if (modules_) modules_->clear();
 }
@@ -153,6 +156,8 @@ void Runtime::adoptPlan(graph::Plan plan) {
         if (it != old.end()) previous = std::move(it->second);
         next.push_back(reuseOrCreateSlot(planned, std::move(previous), diff.isUnchanged(planned.id)));
     }
+    for (auto& [id, dropped] : old)
+        if (dropped) destroyPassObject(*dropped);
     slots_ = std::move(next);
     plan_ = std::move(plan);
     for (size_t i = 0; i < slots_.size(); ++i) allocateTextures(i);
@@ -169,11 +174,12 @@ void Runtime::adoptPlan(graph::Plan plan) {
 std::unique_ptr<PassSlot> Runtime::reuseOrCreateSlot(const graph::PlannedPass& planned,
                                                      std::unique_ptr<PassSlot> slot, bool unchanged) {
     if (!slot || slot->module != planned.module) {
+        if (slot) destroyPassObject(*slot);
         slot = std::make_unique<PassSlot>();
         slot->id = planned.id;
         slot->module = planned.module;
     } else if (!unchanged) {
-        slot->pass.reset();  // its cached decisions were made for other parameters
+        destroyPassObject(*slot);  // its cached decisions were made for other parameters
         slot->error.clear();
     }
     slot->signature = planned.signatureHash;
@@ -189,13 +195,24 @@ std::unique_ptr<PassSlot> Runtime::reuseOrCreateSlot(const graph::PlannedPass& p
 void Runtime::createPassObject(PassSlot& slot, const graph::PlannedPass& planned) {
     const ModuleRegistry::Module* module = modules_->find(planned.module);
     std::string error = "module " + planned.module + " is not loaded";
-    slot.pass.reset();
-    if (module) {
+    destroyPassObject(slot);
+    if (module && module->library->faulted()) {
+        slot.library = module->library;  // activeErrors names the fault
+        error = module->library->fault();
+    } else if (module) {
         slot.library = module->library;
         slot.pass = ModuleLoader::create(module->library, error);
     }
-    if (!slot.pass) slot.error = error;
+    slot.error = slot.pass ? std::string() : error;
     slot.invalidate(false);
+}
+
+// The library's destroy() runs under the guard; a fault there is printed once, and
+// marks the library (no object is created from it again).
+void Runtime::destroyPassObject(PassSlot& slot) {
+    if (!slot.pass) return;
+    slot.pass.reset();
+    if (slot.library && slot.library->takeFaultToReport()) log::error(slot.library->fault());
 }
 
 void Runtime::allocateTextures(size_t i) {
@@ -274,6 +291,7 @@ void Runtime::renderFrame(const SceneView& view, const SceneDraw& scene, const F
     if (!plan_) return;
     const FrameResources shared{slots_, fallbacks_, *shaders_, scene, emptyVao_.id()};
     for (size_t i = 0; i < slots_.size(); ++i) runPass(i, shared, view, frame);
+    recoverFromFaults();
 }
 
 void Runtime::runPass(size_t i, const FrameResources& shared, const SceneView& view, const FrameInfo& frame) {
@@ -281,6 +299,7 @@ void Runtime::runPass(size_t i, const FrameResources& shared, const SceneView& v
     const graph::PlannedPass& planned = plan_->passes[i];
     PassTimings& t = slot.timings;
     if (planned.state != graph::PassState::Run) return t.note(graph::toString(planned.state), planned.reason);
+    if (slot.pass && slot.library && slot.library->faulted()) retireFaultedObject(slot);  // another pass of it faulted
     if (!slot.pass) return t.note("error", slot.error);
     const auto key = runKey(planned, slot, view);
     if (!alwaysRun && !planned.decl.timeDependent && slot.lastRunKey == key && slot.error.empty()) {
@@ -293,13 +312,17 @@ void Runtime::runPass(size_t i, const FrameResources& shared, const SceneView& v
     slot.error.clear();
     HostPassContext ctx(shared, slot, planned, view, frame);
     const auto cpuStart = std::chrono::steady_clock::now();
+    std::optional<std::string> fault;
     {
         gl::DebugGroup group(slot.id);
+        GLint groupDepth = 0;
+        glGetIntegerv(GL_DEBUG_GROUP_STACK_DEPTH, &groupDepth);
         t.timer.begin();
-        try {
-            slot.pass->execute(ctx);
-        } catch (const std::exception& e) {
-            ctx.fail(str("execute() threw: ", e.what()));
+        fault = guard::guarded([&] { slot.pass->execute(ctx); });
+        if (fault) {
+            // What the pass left open is closed: its debug groups, its bindings.
+            for (GLint d = 0; glGetIntegerv(GL_DEBUG_GROUP_STACK_DEPTH, &d), d > groupDepth;) glPopDebugGroup();
+            resetGlState();
         }
         t.timer.end();
     }
@@ -307,15 +330,64 @@ void Runtime::runPass(size_t i, const FrameResources& shared, const SceneView& v
     t.addCpu(cpuMs);
     cost_.passesMs += cpuMs;
 
-    if (ctx.failed()) {
-        slot.lastRunKey.reset();
+    if (fault) {
+        slot.library->markFaulted(str("pass \"", slot.id, "\" (", slot.library->sourcePath().filename().string(),
+                                      "): ", *fault, " in execute()"));
+        retireFaultedObject(slot);
+        faultedModules_.insert(slot.module);
         return t.note("error", slot.error);
     }
+    if (ctx.failed()) {
+        slot.lastRunKey.reset();
+        if (slot.error != slot.loggedError) log::error(slot.id, ": ", slot.loggedError = slot.error);
+        return t.note("error", slot.error);
+    }
+    slot.loggedError.clear();
     ++t.ranFrames;
     slot.lastRunKey = runKey(planned, slot, view);
     if (ctx.nothing()) return t.note("nothing to do", *ctx.nothing());
     t.note("ran", "");
     for (auto& [name, tex] : slot.textures) tex.version = ++versionCounter_;
+}
+
+// The object of a faulted library is abandoned, not destroyed: none of that library's
+// code runs again. Its textures keep their last good contents for the passes after it.
+void Runtime::retireFaultedObject(PassSlot& slot) {
+    (void)slot.pass.release();
+    slot.error = slot.library->fault();
+    slot.lastRunKey.reset();
+}
+
+// After the frame (the plan cannot change under runPass): each module that faulted goes
+// back to the build it replaced, with the running parameters, when there is one; or
+// its passes stay off until its file changes. Either way the fault is logged once and
+// stands in activeErrors until a reload of that module succeeds.
+void Runtime::recoverFromFaults() {
+    std::set<std::string> faulted;
+    faulted.swap(faultedModules_);
+    for (const std::string& name : faulted) {
+        const ModuleRegistry::Module* current = modules_->find(name);
+        if (!current || !current->library->faulted()) continue;
+        const ModuleRegistry::Module broken = *current;
+        const std::string file = broken.library->sourcePath().filename().string();
+        std::string outcome = "; its passes are off until " + file + " changes";
+        if (const ModuleRegistry::Module* previous = modules_->previous(name)) {
+            modules_->set(name, *previous);
+            std::string errors;
+            if (desc_ && loadPipelineDesc(*desc_, errors)) {
+                modules_->keepAsPrevious(name, broken);  // faulted: forgets it
+                for (size_t i = 0; i < slots_.size(); ++i)
+                    if (slots_[i]->module == name && plan_->passes[i].state != graph::PassState::Disabled)
+                        createPassObject(*slots_[i], plan_->passes[i]);
+                outcome = "; rolled back to the build loaded before it, until " + file + " changes";
+            } else {
+                modules_->set(name, broken);
+            }
+        }
+        const std::string message = broken.library->fault() + outcome;
+        setExternalError("module:" + name, message);
+        if (broken.library->takeFaultToReport()) log::error(message);
+    }
 }
 
 // A clean slate for every pass, so one pass's GL state never leaks into the next
@@ -395,8 +467,17 @@ std::vector<NamedTexture> Runtime::textures() const {
 std::vector<std::string> Runtime::activeErrors() const {
     std::vector<std::string> errors;
     for (auto& [key, message] : externalErrors_) errors.push_back(message);
+    std::set<const LoadedModule*> faultsNamed;
     for (auto& s : slots_) {
-        if (!s->error.empty()) errors.push_back(s->id + ": " + s->error);
+        // A faulted module's error stands once, as the module's, not once per pass;
+        // recoverFromFaults has usually put it among the external errors already.
+        if (s->library && s->library->faulted()) {
+            if (faultsNamed.insert(s->library.get()).second && !externalErrors_.count("module:" + s->module))
+                errors.push_back(s->library->fault() + "; its passes are off until " +
+                                 s->library->sourcePath().filename().string() + " changes");
+        } else if (!s->error.empty()) {
+            errors.push_back(s->id + ": " + s->error);
+        }
         for (auto& e : s->programs.standingErrors()) errors.push_back(s->id + ": " + e);
     }
     return errors;
@@ -424,18 +505,19 @@ bool Runtime::reloadModule(const std::string& name, std::string& error) {
         if (!error.empty() && error.back() == '\n') error.pop_back();
         return false;
     }
-    // Validate the pipeline against the new declaration before touching anything.
+    // Validate the running description (the file with the debug view's edits) against
+    // the new declaration before touching anything.
     std::optional<ModuleRegistry::Module> old;
     if (const ModuleRegistry::Module* m = modules_->find(name)) old = *m;
     modules_->set(name, *probed);
     std::string errors;
-    if (!pipelineText_.empty() && !loadPipelineText(pipelineText_, pipelineFile_, errors)) {
+    if (desc_ && !loadPipelineDesc(*desc_, errors)) {
         if (old) modules_->set(name, *old);
         else modules_->erase(name);
         error = errors;
         return false;
     }
-    old.reset();
+    if (old) modules_->keepAsPrevious(name, *old);
     // Objects of the old library go first (their code lives there); their slots keep
     // textures and parameters, and get an object of the new library.
     for (size_t i = 0; i < slots_.size(); ++i)

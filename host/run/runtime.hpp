@@ -7,12 +7,17 @@
 // passes whose signature did not change; renderFrame() executes the passes that run,
 // skipping those whose inputs, parameters and scene categories are all unchanged since
 // their last run. What it keeps per pass is a PassSlot (run/pass_slot.hpp).
+//
+// Every execute() runs under the guard (kiln/guard.hpp). A pass that faults — a fatal
+// signal, an exception, the watchdog — is named once; its module is rolled back to the
+// build it replaced, parameters kept, or its passes stay off until the file changes.
 #pragma once
 
 #include <filesystem>
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -94,7 +99,8 @@ public:
     // error. Returns how many programs were rebuilt successfully.
     int reloadShaders(const std::vector<std::filesystem::path>& changedFiles);
     // Loads a fresh copy of module `name`; on success every pass of that module gets a
-    // new object from it (parameters and textures kept) and the old library goes.
+    // new object from it (parameters, the debug view's edits included, and textures
+    // kept), and the old build is kept to roll back to should the new one fault.
     bool reloadModule(const std::string& name, std::string& error);
     bool usesModule(const std::string& name) const { return modules_ && modules_->uses(name); }
     // Errors from reloads outside the graph (scene file, module), shown until cleared.
@@ -114,6 +120,9 @@ private:
     std::vector<uint64_t> runKey(const graph::PlannedPass&, const PassSlot&, const SceneView&) const;
     void runPass(size_t pass, const FrameResources&, const SceneView&, const FrameInfo&);
     void resetGlState() const;
+    void retireFaultedObject(PassSlot&);
+    void destroyPassObject(PassSlot&);
+    void recoverFromFaults();
     void recompilePlan();
 
     RuntimeOptions options_;
@@ -131,6 +140,7 @@ private:
     TextureLimits limits_;
     uint64_t versionCounter_ = 0;
     std::map<std::string, std::string> externalErrors_;
+    std::set<std::string> faultedModules_;  // this frame's, recovered after it
 };
 
 }  // namespace kiln::run
