@@ -31,6 +31,8 @@ usage: kiln [options]
   --ui-probe FILE   window mode: keep FILE (JSON) up to date with where each
                     debug-view widget is on screen and what the texture readout
                     says, so scripts (xdotool) can drive the window
+  --watchdog S      a pass's execute() (or a module's load) running longer than
+                    S seconds is interrupted and named (default 10; 0: never)
   --seed N          simulation seed (same seed, same frames)
   --paused          do not advance the simulation
   --shaders DIR     shader root (default shaders/, see below)
@@ -140,6 +142,15 @@ std::optional<Options> parseOptions(int argc, char** argv, std::string& error) {
                 return std::nullopt;
             }
             o.budgetMs = static_cast<int>(n);
+        } else if (a == "--watchdog") {
+            auto v = value(a);
+            if (!v) return std::nullopt;
+            long long n = 0;
+            if (!parseInt(*v, n) || n < 0 || n > 86400) {
+                error = "--watchdog " + *v + ": expected whole seconds, 0 to 86400 (0: never)";
+                return std::nullopt;
+            }
+            o.watchdogSeconds = static_cast<int>(n);
         } else if (a == "--frames" || a == "--seed") {
             auto v = value(a);
             if (!v) return std::nullopt;

@@ -31,6 +31,7 @@ struct Options {
     std::string screenshot;   // window: save the window after --frames frames and quit
     std::string view;         // "pass.output" to show instead of the graph output
     int budgetMs = 100;       // window: frame-time budget for the render resolution (0: off)
+    int watchdogSeconds = 10; // bound on one call into a module (0: none)
     std::string uiProbe;      // window: JSON file of widget rectangles and readouts
 };
 

@@ -10,6 +10,7 @@
 #include "app/app.hpp"
 #include "app/cli.hpp"
 #include "app/context.hpp"
+#include "kiln/guard.hpp"
 #include "kiln/image_io.hpp"
 #include "kiln/log.hpp"
 
@@ -49,8 +50,9 @@ int runHeadless(const Options& o) {
         log::info("dumped ", app.runtime().textures().size(), " textures to ", o.dump);
     }
     if (o.stats) std::printf("%s", app.runtime().statsTable().c_str());
-    auto errors = app.runtime().activeErrors();
-    if (!errors.empty()) return fail(errors.front());
+    // Each error was printed when it arose; this line only says why the exit status is 1.
+    if (const size_t standing = app.runtime().activeErrors().size())
+        return fail(str(standing, standing == 1 ? " error" : " errors", " still standing after the last frame (above)"));
     return 0;
 }
 
@@ -66,6 +68,7 @@ int main(int argc, char** argv) {
         return 0;
     }
     applyDefaults(o);
+    guard::setWatchdogLimit(std::chrono::seconds(o.watchdogSeconds));
     if (o.headless) return runHeadless(o);
     return runWindow(o);
 }

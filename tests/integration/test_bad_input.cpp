@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <map>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -52,18 +53,22 @@ struct Case {
     std::string name;
     std::function<std::string(const fs::path& dir)> setup;  // returns the extra arguments
     std::string expect;                                      // in the "kiln: error:" line
+    std::string environment = {};                            // "NAME=value" for the run
+    std::string expectToo = {};                              // in the same line
 };
 
 void check(const Case& c) {
     const fs::path dir = sandbox(c.name, true);
     const std::string args = "--headless --size 24x24 --frames 2 --out " + (dir / "out.png").string() + " " + c.setup(dir);
-    const Run r = runKiln(args, 60);
+    const std::string binary = c.environment.empty() ? KILN_BINARY : "env " + c.environment + " " + KILN_BINARY;
+    const Run r = kiln::test::runProgram(binary, args, 60);
     INFO("case: " << c.name << "\nargs: " << args << "\nstderr:\n" << r.err);
     CHECK(r.exitCode == 1);  // not a signal (128+N), not a hang (124)
     const size_t at = r.err.find("kiln: error: ");
     REQUIRE(at != std::string::npos);
     const std::string line = r.err.substr(at, r.err.find('\n', at) - at);
     CHECK_THAT(line, Catch::Contains(c.expect));
+    CHECK_THAT(line, Catch::Contains(c.expectToo));
     CHECK(line.size() < 400);
     CHECK(r.err.find("GL [") == std::string::npos);  // no GL error on the way
     // Every line says what it is, continuation lines of a shader's log included.
@@ -180,6 +185,13 @@ TEST_CASE("bad module directories", "[integration][robust]") {
              fs::resize_file(d / "m/libpass_gbuffer.so", 4096);
              return with(d); },
          "libpass_gbuffer.so: cannot load: truncated"},
+        // What a linker leaves mid-write: the right size and headers, a body of zeros.
+        {"modules-torn", [&](const fs::path& d) {
+             const std::string full = kiln::test::slurp(fs::path(real) / "libpass_gbuffer.so");
+             const size_t headers = 64 + 56 * 16;  // the ELF header and room for its program headers
+             write(d / "m/libpass_gbuffer.so", full.substr(0, headers) + std::string(full.size() - headers, '\0'));
+             return with(d); },
+         "libpass_gbuffer.so: cannot load: its dynamic section lacks the symbol tables"},
         {"modules-symlink-loop", [&](const fs::path& d) {
              fs::create_directories(d / "m");
              fs::create_symlink("libpass_gbuffer.so", d / "m/libpass_gbuffer.so");
@@ -187,4 +199,31 @@ TEST_CASE("bad module directories", "[integration][robust]") {
          "no module \"gbuffer\""},
     };
     for (auto& c : cases) check(c);
+}
+
+// A pass module with a bug in one of its entry points (tests/core/modules/faulty.cpp,
+// the bug chosen by KILN_TEST_FAULT): one named error, exit 1, never a signal or a hang.
+TEST_CASE("modules that crash, abort, throw or loop", "[integration][robust][guard]") {
+    const std::string modules = "--modules " + std::string(TEST_MODULE_DIR) + ":" + KILN_MODULE_DIR;
+    auto setup = [&](const fs::path& d) {
+        write(d / "faulty.json", R"({"output": "bad.color", "passes": [{"id": "bad", "module": "test_faulty"}]})");
+        return modules + " --watchdog 1 --pipeline " + (d / "faulty.json").string();
+    };
+    const std::map<std::string, std::string> where = {
+        {"static", "in its static initialisers or kiln_pass_module()"},
+        {"entry", "in its static initialisers or kiln_pass_module()"},
+        {"create", "in create()"}, {"declare", "in declare()"}, {"execute", "in execute()"}, {"destroy", "in destroy()"}};
+    std::vector<std::pair<std::string, std::string>> faults;  // spec, expected fault
+    for (auto& [entry, text] : where) {
+        faults.push_back({"segv@" + entry, "SIGSEGV"});
+        faults.push_back({"loop@" + entry, "no return after 1.0 s"});
+    }
+    faults.insert(faults.end(), {{"abort@execute", "SIGABRT"}, {"stack@execute", "SIGSEGV"},
+                                 {"throw@execute", "exception of type int"}, {"throw@declare", "exception of type int"},
+                                 {"throw@static", "SIGABRT"}, {"throw@entry", "an exception"}, {"abort@create", "SIGABRT"}});
+    for (auto& [spec, fault] : faults) {
+        const std::string entry = spec.substr(spec.find('@') + 1);
+        check({"fault-" + spec.substr(0, spec.find('@')) + "-" + entry, setup, fault, "KILN_TEST_FAULT=" + spec,
+               where.at(entry)});
+    }
 }
