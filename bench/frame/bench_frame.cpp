@@ -17,17 +17,21 @@
 //
 // overhead: the CPU time of Runtime::renderFrame against the part inside the passes'
 // execute(): the rest is the graph's own (version checks, state resets, timer queries,
-// uniform upload, bookkeeping), moving and paused, as a share of the frame.
+// uniform upload, bookkeeping), moving and paused, as a share of the frame; and what the
+// guard around each execute() costs per call and per frame.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "app/app.hpp"
 #include "app/context.hpp"
+#include "kiln/guard.hpp"
 #include "kiln/log.hpp"
 #include "support/bench_support.hpp"
 
@@ -37,6 +41,30 @@ using namespace kiln::bench;
 using Json = nlohmann::json;
 
 namespace {
+
+// What the guard adds to one call: the median over rounds of 200 000 guarded calls of
+// an empty function, less the same calls unguarded.
+struct GuardCost {
+    double perCallUs = 0.0, plainUs = 0.0;
+};
+void emptyCall() {}
+GuardCost measureGuard(int rounds) {
+    constexpr int kCalls = 200000;
+    void (*volatile fn)() = emptyCall;  // not inlined away
+    std::vector<double> guarded, plain;
+    for (int r = 0; r < std::max(rounds, 3); ++r) {
+        auto t0 = std::chrono::steady_clock::now();
+        for (int i = 0; i < kCalls; ++i) (void)guard::guarded([&] { fn(); });
+        auto t1 = std::chrono::steady_clock::now();
+        for (int i = 0; i < kCalls; ++i) fn();
+        auto t2 = std::chrono::steady_clock::now();
+        guarded.push_back(std::chrono::duration<double, std::micro>(t1 - t0).count() / kCalls);
+        plain.push_back(std::chrono::duration<double, std::micro>(t2 - t1).count() / kCalls);
+    }
+    std::sort(guarded.begin(), guarded.end());
+    std::sort(plain.begin(), plain.end());
+    return {guarded[guarded.size() / 2] - plain[plain.size() / 2], plain[plain.size() / 2]};
+}
 
 struct Args {
     int width = 256, height = 256, frames = 30, repeats = 3;
@@ -201,6 +229,17 @@ int main(int argc, char** argv) {
             csv << r.label << ',' << total << ',' << r.passesMs << ',' << r.hostMs << ',' << share << '\n';
         }
         std::printf("\n(CPU side of Runtime::renderFrame; the frame's wall time, GPU work included, is in kiln-bench-skip)\n");
+        // The guard around each execute() (kiln/guard.hpp) is inside "in passes": timed
+        // here on its own, an empty call guarded against the same call unguarded.
+        const GuardCost g = measureGuard(args.repeats);
+        int passesRun = 0;
+        for (auto& p : outcomes.front().passes) passesRun += p.ran > 0;
+        const double perFrameMs = g.perCallUs * passesRun / 1000.0;
+        const double movingMs = outcomes.front().hostMs + outcomes.front().passesMs;
+        std::printf("guard: %.3f us per guarded call (%.3f us unguarded); %d passes ran per moving frame: %.4f ms, "
+                    "%.3f%% of its renderFrame\n", g.perCallUs, g.plainUs, passesRun, perFrameMs,
+                    movingMs > 0 ? 100 * perFrameMs / movingMs : 0.0);
+        csv << "guard," << g.perCallUs / 1000.0 * passesRun << ",,," << "\n";
     } else {
         csv << "situation,pass,state,gpu_ms,cpu_ms,ran,skipped,frame_ms,frame_ratio\n";
         const double moving = outcomes.front().frameMs;

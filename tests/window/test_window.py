@@ -4,7 +4,10 @@ with xdotool, judged on what the screen shows (screenshots read back with ImageM
 and on what a headless run of the same frame reads back. kiln --ui-probe says where each
 widget is; nothing else of the window's insides is used.
 
-usage: test_window.py KILN SOURCE_DIR OUT_DIR      (run under xvfb-run; ctest does)
+usage: test_window.py KILN SOURCE_DIR OUT_DIR BUGGY_MODULE FIXED_MODULE
+       (run under xvfb-run; ctest does). The two modules are builds of
+       tests/core/modules/faulty.cpp: the window must survive the first and pick up the
+       second.
 """
 import difflib
 import json
@@ -14,7 +17,7 @@ import subprocess
 import sys
 import time
 
-KILN, SOURCE, OUT = sys.argv[1], sys.argv[2], sys.argv[3]
+KILN, SOURCE, OUT, BUGGY_MODULE, FIXED_MODULE = sys.argv[1:6]
 W, H = 320, 640  # the image; the window adds the panels' column
 failures = []
 
@@ -111,6 +114,13 @@ default = os.path.join(pipelines, "default.json")
 original_text = open(default).read()
 if os.path.exists(PROBE):
     os.remove(PROBE)
+# A module whose execute() segfaults (KILN_TEST_FAULT), in a module directory of its own
+# ahead of the build's (the pipeline that uses it is written at step 8).
+modules = os.path.join(OUT, "modules")
+shutil.rmtree(modules, ignore_errors=True)
+os.makedirs(modules)
+shutil.copy(BUGGY_MODULE, os.path.join(modules, "libpass_test_faulty.so"))
+build_modules = os.path.join(os.path.dirname(os.path.dirname(KILN)), "modules")
 
 # What a headless run reads back for the same paused frame at the same size.
 dump = os.path.join(OUT, "dump")
@@ -119,7 +129,9 @@ sh(KILN, "--headless", "--paused", "--size", "%dx%d" % (W, H), "--pipeline", def
    "--view", "gbuffer.albedo", "--no-live")
 
 kiln = subprocess.Popen([KILN, "--paused", "--size", "%dx%d" % (W, H), "--pipeline", default, "--budget", "0",
-                         "--ui-probe", PROBE], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+                         "--ui-probe", PROBE, "--modules", modules + ":" + build_modules],
+                        env=dict(os.environ, KILN_TEST_FAULT="segv@execute"),
+                        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
 try:
     wait_for(lambda p: p["frame"] >= 3, "the first frames")
     WINDOW = sh("xdotool", "search", "--sync", "--name", "^Kiln$").split()[0]
@@ -204,7 +216,30 @@ try:
     check(not p["errors"] and not p["editor_error"], "voxels.json runs without errors: %s %s" % (p["errors"], p["editor_error"]))
     screenshot("voxels.png")
 
-    # 8. The compare view: compare.json turns it on with figures of composite.hdr
+    # 8. A pass module that segfaults in execute(): the window names it and keeps
+    #    drawing; a fixed build written over it is picked up live.
+    #    (Written now, and named to sort near the top: the list at 640 px shows ten.)
+    with open(os.path.join(pipelines, "crash.json"), "w") as f:
+        f.write('{"output": "bad.color", "passes": [{"id": "bad", "module": "test_faulty"}]}\n')
+    click("pipeline-switcher")
+    wait_for(lambda p: "pipeline:crash.json" in p["widgets"], "the pipeline list")
+    click("pipeline:crash.json")
+    p = wait_for(lambda p: p["pipeline"].endswith("crash.json") and p["errors"], "the fault named")
+    named = [e for e in p["errors"] if 'pass "bad" (libpass_test_faulty.so): SIGSEGV' in e and "in execute()" in e]
+    check(len(named) == 1 and len(p["errors"]) == 1, "the segfault is one error naming the pass and the module: %s" % p["errors"])
+    frames_later(5)
+    check(kiln.poll() is None, "the window keeps drawing after the segfault")
+    screenshot("fault.png")
+    shutil.copy(FIXED_MODULE, os.path.join(modules, ".libpass_test_faulty.so.new"))
+    os.rename(os.path.join(modules, ".libpass_test_faulty.so.new"), os.path.join(modules, "libpass_test_faulty.so"))
+    p = wait_for(lambda p: not p["errors"], "the fixed build picked up")
+    frames_later()
+    shot = screenshot("fixed.png")
+    ix, iy, iw, ih = p["image"]
+    r, g, b = screen_pixel(ix + iw // 2, iy + ih - 24, shot)  # below the texture window
+    check(g > 200 and b < 40, "the fixed build fills the image with its green: %s" % [r, g, b])
+
+    # 9. The compare view: compare.json turns it on with figures of composite.hdr
     #    against the reference; the line follows a drag.
     click("pipeline-switcher")
     wait_for(lambda p: "pipeline:compare.json" in p["widgets"], "the pipeline list")
@@ -225,6 +260,7 @@ try:
     p = wait_for(lambda p: abs(p["compare"]["split"] - 0.25) < 0.03, "the line at a quarter")
     check(True, "dragging the compare line moves it to %.3f" % p["compare"]["split"])
     screenshot("compare.png")
+
 finally:
     kiln.terminate()
     try:
