@@ -336,6 +336,25 @@ bool readPhysics(const Json& root, Scene& s, SceneError& error) {
             !r.number("ballast_h", s.physics.ballastH, -0.19, 0.19) || !r.number("seed", seed, 0, 4294967295.0) || !r.finish())
             return false;
         if (!restitution(*o, s.physics.restitution, error)) return false;
+        // Sub-steps longer than kMaxFixedSubstep were unstable: a tumbler spun by ball
+        // hits gained energy without bound (NaN within 60 frames at Δt 0.1 in a crowded
+        // box). Adaptive sub-stepping never goes above it (World::substepsFor); a scene
+        // whose sub-step count cannot reach it is refused.
+        const bool adaptive = s.physics.maxSubsteps > s.physics.substeps;
+        const int most = std::max(s.physics.substeps, s.physics.maxSubsteps);
+        const int needed = int(std::ceil(s.physics.dt / kMaxFixedSubstep - 1e-9));
+        if (most < needed) {
+            const std::string substep = std::to_string(s.physics.dt / most * 1000.0).substr(0, 6) + " ms";
+            error = {"physics.max_substeps",
+                     (adaptive ? "max_substeps " + std::to_string(most) + " allows sub-steps of dt/max_substeps = " + substep
+                               : "adaptive sub-steps are off (max_substeps " + std::to_string(s.physics.maxSubsteps) +
+                                     " <= substeps " + std::to_string(s.physics.substeps) + ") and a fixed sub-step of dt/substeps = " +
+                                     substep) +
+                         ", longer than the 4.17 ms (1/240 s) that stays stable: " +
+                         (adaptive ? "set max_substeps to at least " + std::to_string(needed)
+                                   : "set substeps to at least " + std::to_string(needed) + ", or max_substeps above substeps")};
+            return false;
+        }
         s.physics.tumblerMode = TumblerMode(mode);
         s.physics.tumblerContact = TumblerContact(contact);
         s.physics.seed = uint64_t(seed);

@@ -40,7 +40,7 @@ void World::reset(const Scene& scene) {
     rng_.reseed(scene.physics.seed);
     time_ = 0.0;
     removedBallEnergy_ = 0.0;
-    substepDt_ = scene.physics.dt / std::max(1, scene.physics.substeps);
+    substepDt_ = scene.physics.dt / fewestSubsteps(scene.physics);  // what a calm first frame uses
     steps_ = 0;
     ++bodiesVersion_;
     ++particlesVersion_;
@@ -146,11 +146,21 @@ void World::settleTumblers() {
     }
 }
 
+// Adaptive sub-steps are never longer than kMaxFixedSubstep: a body that starts the frame
+// slow may be hit and spun fast within it (scene.cpp refuses a ceiling that cannot reach
+// this; a fixed count is the scene's to choose, and the scene file holds it to the same
+// bound).
+int World::fewestSubsteps(const Scene::Physics& p) {
+    const int n = std::max(1, p.substeps);
+    if (p.maxSubsteps <= n) return n;
+    return std::min(p.maxSubsteps, std::max(n, int(std::ceil(p.dt / kMaxFixedSubstep - 1e-9))));
+}
+
 int World::substepsFor(double frame) const {
     // Adaptive sub-stepping: at least the scene's count, more when a body would move
     // further per sub-step than the contacts can follow — a tumbler point more than
     // kMaxTumblerMove (a quarter of the upper radius), a ball more than half its radius;
-    // at most physics.max_substeps.
+    // at most physics.max_substeps, never longer than kMaxFixedSubstep.
     // At the shipped Δt nothing triggers it; at 1/15 s it keeps contacts resolvable.
     constexpr double kMaxTumblerMove = 0.025;
     const double reach = 2.0 * shape_.b() + shape_.top();  // |X − P| for any body point X
@@ -161,7 +171,7 @@ int World::substepsFor(double frame) const {
         const double speed = glm::length(b.velocity) + scene_.physics.gravity * frame;
         need = std::max(need, speed * frame / (0.5 * b.radius));
     }
-    const int n = std::max(1, scene_.physics.substeps);
+    const int n = fewestSubsteps(scene_.physics);
     const int wanted = std::clamp(int(std::ceil(std::min(need, 1e6))), n, std::max(n, scene_.physics.maxSubsteps));
     // Bounded work per step, whatever the scene asks: sub-steps × (ball-tumbler pairs +
     // ball pairs the broad phase looked at last + tumbler pairs) stays within
@@ -213,8 +223,9 @@ void World::substep(double dt) {
     }
     collideBallPairs();
     // Contact pushes may nudge a ball past a wall or back into a tumbler: walls first
-    // (exact per sphere), then tumblers give way where a ball has nowhere to go.
-    for (auto& b : balls_) b.position = glm::clamp(b.position, Vec3(b.radius - 1.0), Vec3(1.0 - b.radius));
+    // (exact per sphere, and paid for: a ball lifted off the floor by the clamp pays the
+    // height from its speed), then tumblers give way where a ball has nowhere to go.
+    for (auto& b : balls_) moveBallKeepingEnergy(b, glm::clamp(b.position, Vec3(b.radius - 1.0), Vec3(1.0 - b.radius)));
     if (separateBallsFromTumblers()) settleTumblers();
     // Burning marbles turn to ash.
     for (size_t i = 0; i < balls_.size();) {

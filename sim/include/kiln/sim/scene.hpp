@@ -19,7 +19,8 @@
 //     "physics": {
 //       "dt": 0.0041667,            // one frame (s), (0, 0.1]
 //       "substeps": 4,              // sub-steps per frame, 1..64
-//       "max_substeps": 256,        // adaptive ceiling for fast bodies, ≥ 1 (≤ substeps: off)
+//       "max_substeps": 256,        // adaptive ceiling for fast bodies, ≥ 1 (≤ substeps: off,
+//                                   //   allowed only with dt/substeps ≤ 1/240 s)
 //       "gravity": 9.81,            // m/s², [0, 100]
 //       "friction": 0.005,          // μ of the rocking damping (SPEC §4.1), [0, 10]
 //       "wall_decay": 0.5,          // tumbler velocity kept after hitting a wall, [0, 1]
@@ -73,6 +74,9 @@ inline constexpr size_t kMaxMarbles = 1024;
 inline constexpr size_t kMaxFireballs = 64;
 inline constexpr int kMaxSceneNesting = 32;  // as the pipeline loader
 inline constexpr size_t kMaxSceneFileBytes = size_t(16) << 20;
+// The longest fixed sub-step (adaptive sub-steps off) a scene may ask for; longer ones
+// let a tumbler spun by ball hits gain energy without bound (tests/sim/test_conservation.cpp).
+inline constexpr double kMaxFixedSubstep = 1.0 / 240.0;
 
 struct SceneError {
     std::string path;     // JSON path, e.g. "tumblers[2].position"; empty for syntax errors

@@ -127,6 +127,9 @@ public:
     void step();
     // The sub-step count step() would use for a frame of `frame` seconds now.
     int substepsFor(double frame) const;
+    // The count a frame starts from: the scene's substeps, raised (when sub-steps adapt)
+    // until none is longer than kMaxFixedSubstep.
+    static int fewestSubsteps(const Scene::Physics&);
 
     const Scene& scene() const { return scene_; }
     const RoundCone& shape() const { return shape_; }
