@@ -87,7 +87,7 @@ TEST_CASE("a rebuilt module is swapped in with its parameters kept, a broken one
     CHECK(near(box.centre(), {0.0f, 0.25f, 1.0f}));  // the previous module keeps running
 }
 
-TEST_CASE("a module written in two halves is retried, not reported broken, and one left truncated is", "[live][gl]") {
+TEST_CASE("a module written in two halves or torn is retried, not reported broken, and one left truncated is", "[live][gl]") {
     const std::string pipeline = R"({"output": "tint.color",
         "passes": [{"id": "tint", "module": "live_tint", "params": {"level": 0.25}}]})";
     const fs::path v1 = fs::path(LIVE_MODULE_BUILDS) / "tint_v1.so", v2 = fs::path(LIVE_MODULE_BUILDS) / "tint_v2.so";
@@ -110,6 +110,19 @@ TEST_CASE("a module written in two halves is retried, not reported broken, and o
     CHECK(box.app.live().failures == failures);
     CHECK(box.app.live().pendingModules() == 0);
     CHECK_FALSE(box.errorMentions("libpass_live_tint.so"));
+
+    // Torn: the full size and the right headers, a body of zeros (what a linker leaves
+    // mid-write). Waited for like a short file, never mapped; then the real bytes.
+    const size_t headers = 64 + 56 * 16;
+    writeInPlace(installed, full.substr(0, headers) + std::string(full.size() - headers, '\0'));
+    REQUIRE(box.waitFor([&] { return box.app.live().pendingModules() == 1; }));
+    CHECK(box.app.live().failures == failures);
+    CHECK(near(box.centre(), {0.0f, 0.25f, 1.0f}));
+    writeInPlace(installed, slurp(v1));
+    CHECK(box.waitFor([&] { return near(box.centre(), {1.0f, 0.25f, 0.0f}); }));
+    CHECK(box.app.live().pendingModules() == 0);
+    writeInPlace(installed, full);
+    CHECK(box.waitFor([&] { return near(box.centre(), {0.0f, 0.25f, 1.0f}); }));
 
     // Left truncated: after the retry window it is a named error, once.
     writeInPlace(installed, full.substr(0, 4096));
