@@ -3,6 +3,7 @@
 #include <pthread.h>
 #include <setjmp.h>
 #include <signal.h>
+#include <ucontext.h>
 
 #include <algorithm>
 #include <atomic>
@@ -33,6 +34,7 @@ struct Frame {
     Frame* outer = nullptr;
     uint64_t id = 0;
     std::chrono::milliseconds limit{0};  // of the watchdog; 0: not watched
+    CodeRange interruptible;             // where the watchdog may stop it
     volatile int signal = 0;
     volatile int code = 0;
     void* volatile address = nullptr;
@@ -46,12 +48,29 @@ thread_local bool tHasAltStack = false;
 struct sigaction gPrevious[NSIG];
 std::once_flag gInstallOnce;
 
+// Where the thread was when the signal came; 0 where the platform is not known here
+// (then anywhere counts as the module's code).
+uintptr_t interruptedAt(void* context) {
+    const auto* uc = static_cast<const ucontext_t*>(context);
+#if defined(__x86_64__)
+    return uintptr_t(uc->uc_mcontext.gregs[REG_RIP]);
+#elif defined(__aarch64__)
+    return uintptr_t(uc->uc_mcontext.pc);
+#else
+    (void)uc;
+    return 0;
+#endif
+}
+
 void onSignal(int sig, siginfo_t* info, void* context) {
     if (sig == watchdogSignal()) {
-        // Stale (the call returned meanwhile) unless a frame on this thread has the id.
+        // Stale (the call returned meanwhile) unless a frame on this thread has the id;
+        // ignored (the watchdog asks again) while the thread is outside the module's code.
         const auto id = reinterpret_cast<uintptr_t>(info->si_value.sival_ptr);
         for (Frame* f = tCurrent; f; f = f->outer)
             if (info->si_code == SI_QUEUE && f->id == id) {
+                const uintptr_t pc = interruptedAt(context);
+                if (pc && !f->interruptible.contains(pc)) return;
                 f->signal = sig;
                 siglongjmp(f->jump, 1);
             }
@@ -87,7 +106,7 @@ void onSignal(int sig, siginfo_t* info, void* context) {
 void install(bool first) {
     struct sigaction action {};
     action.sa_sigaction = onSignal;
-    action.sa_flags = SA_SIGINFO | SA_ONSTACK;
+    action.sa_flags = SA_SIGINFO | SA_ONSTACK | SA_RESTART;  // a watchdog signal it ignores restarts the wait it broke
     sigemptyset(&action.sa_mask);
     for (int sig : kFatalSignals) sigaction(sig, &action, first ? &gPrevious[sig] : nullptr);
     sigaction(watchdogSignal(), &action, first ? &gPrevious[watchdogSignal()] : nullptr);
@@ -116,7 +135,7 @@ void ensureAltStack() {
 }
 
 // The watchdog: one thread for the process, started by the first watched call.
-struct Watch {
+struct Deadline {
     pthread_t thread;
     uint64_t id;
     Clock::time_point deadline;
@@ -124,7 +143,7 @@ struct Watch {
 std::atomic<int64_t> gLimitMs{10000};
 std::atomic<uint64_t> gNextId{1};
 std::mutex gWatchMutex;
-std::vector<Watch> gWatches;
+std::vector<Deadline> gDeadlines;
 std::once_flag gWatchdogOnce;
 
 void watchdogLoop() {
@@ -133,7 +152,7 @@ void watchdogLoop() {
         std::this_thread::sleep_for(std::chrono::milliseconds(limit > 0 ? std::clamp<int64_t>(limit / 10, 5, 200) : 200));
         std::lock_guard lock(gWatchMutex);
         const auto now = Clock::now();
-        for (Watch& w : gWatches) {
+        for (Deadline& w : gDeadlines) {
             if (now < w.deadline) continue;
             union sigval value;
             value.sival_ptr = reinterpret_cast<void*>(static_cast<uintptr_t>(w.id));
@@ -143,15 +162,15 @@ void watchdogLoop() {
     }
 }
 
-void watch(uint64_t id, std::chrono::milliseconds limit) {
+void startWatching(uint64_t id, std::chrono::milliseconds limit) {
     std::call_once(gWatchdogOnce, [] { std::thread(watchdogLoop).detach(); });
     std::lock_guard lock(gWatchMutex);
-    gWatches.push_back({pthread_self(), id, Clock::now() + limit});
+    gDeadlines.push_back({pthread_self(), id, Clock::now() + limit});
 }
 
-void unwatch(uint64_t id) {
+void stopWatching(uint64_t id) {
     std::lock_guard lock(gWatchMutex);
-    std::erase_if(gWatches, [id](const Watch& w) { return w.id == id; });
+    std::erase_if(gDeadlines, [id](const Deadline& w) { return w.id == id; });
 }
 
 std::string demangled(const char* name) {
@@ -209,14 +228,15 @@ std::string signalName(int signal) {
 
 namespace detail {
 
-std::optional<std::string> call(void (*thunk)(void*), void* fn, bool watched) {
+std::optional<std::string> call(void (*thunk)(void*), void* fn, const Watch& watch) {
     ensureInstalled();
     ensureAltStack();
     Frame frame;
     frame.outer = tCurrent;
     frame.id = gNextId++;
-    frame.limit = watched ? watchdogLimit() : std::chrono::milliseconds(0);
-    if (frame.limit.count() > 0) watch(frame.id, frame.limit);
+    frame.limit = watch.on ? watchdogLimit() : std::chrono::milliseconds(0);
+    frame.interruptible = watch.code;
+    if (frame.limit.count() > 0) startWatching(frame.id, frame.limit);
 
     // Written only before the jump can happen or after it landed: safe across it.
     std::optional<std::string> fault;
@@ -234,7 +254,7 @@ std::optional<std::string> call(void (*thunk)(void*), void* fn, bool watched) {
         fault = describe(frame);
     }
     tCurrent = frame.outer;
-    if (frame.limit.count() > 0) unwatch(frame.id);
+    if (frame.limit.count() > 0) stopWatching(frame.id);
     return fault;
 }
 

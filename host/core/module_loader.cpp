@@ -3,6 +3,7 @@
 #include <dlfcn.h>
 #include <elf.h>
 #include <fcntl.h>
+#include <link.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -178,6 +179,31 @@ bool checkDynamicSection(std::ifstream& in, const Elf64_Ehdr& eh, uint64_t size,
 // child process, where a crash or a hang costs nothing: the host learns the signal and
 // never maps the library. Returns the fault, or nothing when the child came back (an
 // ordinary dlopen error is left for the host's own dlopen to report).
+// The addresses of a loaded library's executable segments (one, for a module).
+guard::CodeRange codeOf(void* handle) {
+    struct link_map* map = nullptr;
+    if (dlinfo(handle, RTLD_DI_LINKMAP, &map) != 0 || !map) return {};
+    struct Search {
+        ElfW(Addr) base;
+        guard::CodeRange range;
+    } search{map->l_addr, {}};
+    dl_iterate_phdr(
+        [](dl_phdr_info* info, size_t, void* data) {
+            auto* s = static_cast<Search*>(data);
+            if (info->dlpi_addr != s->base) return 0;
+            for (int i = 0; i < info->dlpi_phnum; ++i) {
+                const ElfW(Phdr)& ph = info->dlpi_phdr[i];
+                if (ph.p_type != PT_LOAD || !(ph.p_flags & PF_X)) continue;
+                const uintptr_t begin = info->dlpi_addr + ph.p_vaddr, end = begin + ph.p_memsz;
+                const bool first = s->range.begin >= s->range.end;
+                s->range = {first ? begin : std::min(s->range.begin, begin), first ? end : std::max(s->range.end, end)};
+            }
+            return 1;
+        },
+        &search);
+    return search.range;
+}
+
 constexpr int kThrewStatus = 3;
 
 std::optional<std::string> trialOpen(const fs::path& file) {
@@ -270,15 +296,18 @@ std::shared_ptr<LoadedModule> ModuleLoader::load(const std::string& name, std::s
     using EntryFn = const KilnPassModule* (*)();
     const KilnPassModule* desc = nullptr;
     bool opened = false, hasEntry = false;
-    if (auto fault = guard::guarded([&] {
-            module->handle_ = dlopen(copy.c_str(), RTLD_NOW | RTLD_LOCAL);
-            if (!module->handle_) return;
-            opened = true;
-            auto entry = reinterpret_cast<EntryFn>(dlsym(module->handle_, "kiln_pass_module"));
-            if (!entry) return;
-            hasEntry = true;
-            desc = entry();
-        })) {
+    // Not watched: dlopen holds the dynamic loader's lock (the child timed the loops).
+    if (auto fault = guard::guarded(
+            [&] {
+                module->handle_ = dlopen(copy.c_str(), RTLD_NOW | RTLD_LOCAL);
+                if (!module->handle_) return;
+                opened = true;
+                auto entry = reinterpret_cast<EntryFn>(dlsym(module->handle_, "kiln_pass_module"));
+                if (!entry) return;
+                hasEntry = true;
+                desc = entry();
+            },
+            guard::kUnwatched)) {
         module->markFaulted(source.string() + ": " + *fault + " in its static initialisers or kiln_pass_module()");
         error = source.string() + ": cannot load: " + *fault + " in its static initialisers or kiln_pass_module()";
         return nullptr;
@@ -288,6 +317,7 @@ std::shared_ptr<LoadedModule> ModuleLoader::load(const std::string& name, std::s
         error = source.string() + ": cannot load: " + (why ? why : "dlopen failed");
         return nullptr;
     }
+    module->code_ = codeOf(module->handle_);
     if (!hasEntry) {
         error = source.string() + ": not a Kiln pass module (no exported symbol kiln_pass_module)";
         return nullptr;
@@ -312,7 +342,7 @@ std::shared_ptr<LoadedModule> ModuleLoader::load(const std::string& name, std::s
 
 PassPtr ModuleLoader::create(const std::shared_ptr<LoadedModule>& module, std::string& error) {
     Pass* raw = nullptr;
-    if (auto fault = guard::guarded([&] { raw = module->desc_->create(); })) {
+    if (auto fault = guard::guarded([&] { raw = module->desc_->create(); }, module->watch())) {
         const std::string what = module->source_.filename().string() + ": " + *fault + " in create()";
         if (fault->rfind("exception", 0) != 0) module->markFaulted(what);  // a throw unwound; a signal did not
         error = module->source_.string() + ": factory failed: " + *fault + " in create()";
@@ -326,7 +356,7 @@ PassPtr ModuleLoader::create(const std::shared_ptr<LoadedModule>& module, std::s
     auto destroy = module->desc_->destroy;
     return PassPtr(raw, [module, destroy](Pass* p) {
         if (module->faulted()) return;  // its code is not called again: the object is lost
-        if (auto fault = guard::guarded([&] { destroy(p); }))
+        if (auto fault = guard::guarded([&] { destroy(p); }, module->watch()))
             module->markFaulted(module->source_.filename().string() + ": " + *fault + " in destroy()");
     });
 }

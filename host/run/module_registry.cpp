@@ -11,7 +11,7 @@ graph::Result<ModuleRegistry::Module> ModuleRegistry::probe(const std::string& n
     PassPtr object = ModuleLoader::create(library, error);
     if (!object) return graph::Result<Module>::failure(error);
     PassDeclaration decl;
-    if (auto fault = guard::guarded([&] { decl = object->declare(); })) {
+    if (auto fault = guard::guarded([&] { decl = object->declare(); }, library->watch())) {
         const std::string what = library->sourcePath().filename().string() + ": " + *fault + " in declare()";
         if (fault->rfind("exception", 0) != 0) library->markFaulted(what);  // a signal did not unwind
         return graph::Result<Module>::failure(library->sourcePath().string() + ": " + *fault + " in declare()");

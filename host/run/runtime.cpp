@@ -318,7 +318,7 @@ void Runtime::runPass(size_t i, const FrameResources& shared, const SceneView& v
         GLint groupDepth = 0;
         glGetIntegerv(GL_DEBUG_GROUP_STACK_DEPTH, &groupDepth);
         t.timer.begin();
-        fault = guard::guarded([&] { slot.pass->execute(ctx); });
+        fault = guard::guarded([&] { slot.pass->execute(ctx); }, slot.library->watch());
         if (fault) {
             // What the pass left open is closed: its debug groups, its bindings.
             for (GLint d = 0; glGetIntegerv(GL_DEBUG_GROUP_STACK_DEPTH, &d), d > groupDepth;) glPopDebugGroup();

@@ -21,6 +21,7 @@
 #include <utility>
 #include <vector>
 
+#include "kiln/guard.hpp"
 #include "kiln/pass.hpp"
 
 namespace kiln {
@@ -34,6 +35,9 @@ public:
     const std::string& name() const { return name_; }
     const std::filesystem::path& sourcePath() const { return source_; }
     const KilnPassModule& descriptor() const { return *desc_; }
+    // The guard's watch for a call into this library: the watchdog interrupts only while
+    // the library's own code runs.
+    guard::Watch watch() const { return {true, code_}; }
 
     // Set when code of this library faulted: the message names the file, the fault and
     // the entry point. A faulted library stays mapped for the rest of the run.
@@ -52,6 +56,7 @@ private:
     const KilnPassModule* desc_ = nullptr;
     std::string fault_;
     bool faultReported_ = false;
+    guard::CodeRange code_;
 };
 
 // A pass object that keeps its library loaded for as long as it lives, and is
