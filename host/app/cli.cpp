@@ -133,24 +133,18 @@ std::optional<Options> parseOptions(int argc, char** argv, std::string& error) {
             }
             o.width = static_cast<int>(w);
             o.height = static_cast<int>(h);
-        } else if (a == "--budget") {
+        } else if (a == "--budget" || a == "--watchdog") {
             auto v = value(a);
             if (!v) return std::nullopt;
+            const bool budget = a == "--budget";
+            const long long most = budget ? 100000 : 86400;
             long long n = 0;
-            if (!parseInt(*v, n) || n < 0 || n > 100000) {
-                error = "--budget " + *v + ": expected milliseconds, 0 to 100000 (0: off)";
+            if (!parseInt(*v, n) || n < 0 || n > most) {
+                error = std::string(a) + " " + *v + ": expected " + (budget ? "milliseconds" : "whole seconds") + ", 0 to " +
+                        std::to_string(most) + (budget ? " (0: off)" : " (0: never)");
                 return std::nullopt;
             }
-            o.budgetMs = static_cast<int>(n);
-        } else if (a == "--watchdog") {
-            auto v = value(a);
-            if (!v) return std::nullopt;
-            long long n = 0;
-            if (!parseInt(*v, n) || n < 0 || n > 86400) {
-                error = "--watchdog " + *v + ": expected whole seconds, 0 to 86400 (0: never)";
-                return std::nullopt;
-            }
-            o.watchdogSeconds = static_cast<int>(n);
+            (budget ? o.budgetMs : o.watchdogSeconds) = static_cast<int>(n);
         } else if (a == "--frames" || a == "--seed") {
             auto v = value(a);
             if (!v) return std::nullopt;

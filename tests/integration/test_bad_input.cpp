@@ -83,7 +83,8 @@ void check(const Case& c) {
 TEST_CASE("bad command-line values", "[integration][cli][robust]") {
     for (const char* args : {"--size 0x0", "--size -5x5", "--size 100000x100000", "--size 12", "--size", "--frames -3",
                              "--frames", "--frames 1x", "--frames 4294967297", "--frames 2147483648", "--frames 99999999999999999999", "--bogus", "--pipeline", "--seed banana",
-                             "--budget -1", "--budget fast", "--budget", "--ui-probe"}) {
+                             "--budget -1", "--budget fast", "--budget", "--ui-probe", "--watchdog -1", "--watchdog 86401",
+                             "--watchdog 1.5"}) {
         const Run r = runKiln(std::string("--headless ") + args, 60);
         INFO(args << "\n" << r.err);
         CHECK(r.exitCode == 1);
