@@ -38,8 +38,9 @@ double ballCentreClearance(const World& w) {
     return worst;
 }
 
-// Mechanical energy from the state alone, with PHYSICS.md's mass properties rather than
-// the simulation's own (World::totalEnergy): balls ½m|v|² + m·g·y (fireballs float: no
+// Mechanical energy from the state alone, with the independently derived mass properties
+// that test_shape.cpp checks the shape's quadrature against (12 digits), rather than the
+// simulation's own sum (World::totalEnergy): balls ½m|v|² + m·g·y (fireballs float: no
 // g); a tumbler (accurate mode, rolling on its lower sphere) ½m|ω×(G−P)|² +
 // ½ωᵀ(R·I_G·Rᵀ)ω + m·g·G_y with G = O − h·axis, P = O − b·ŷ.
 double independentEnergy(const World& w) {
