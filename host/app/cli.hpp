@@ -1,4 +1,4 @@
-// app/cli.hpp — the `kiln` command line (SPEC §10).
+// app/cli.hpp — the `kiln` command line (the README's "Command line" lists it).
 #pragma once
 
 #include <cstdint>

@@ -1,0 +1,416 @@
+// The debug view's panels, one ImGui window each (passes, parameters, textures, scene,
+// graph, errors, and the texture viewer), reading the host's state every frame
+// (immediate mode, nothing to keep in sync); and the image beside them.
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "app/window_state.hpp"
+#include "kiln/log.hpp"
+
+namespace kiln::app {
+
+namespace fs = std::filesystem;
+
+bool PipelineEditor::apply(App& app, const std::function<void(graph::PipelineDesc&)>& edit) {
+    Runtime& rt = app.runtime();
+    if (!rt.pipelineDesc()) return false;
+    graph::PipelineDesc desc = *rt.pipelineDesc();
+    edit(desc);
+    std::string errors;
+    if (!rt.loadPipelineDesc(std::move(desc), errors)) {
+        error = errors;  // the running plan stays
+        return false;
+    }
+    error.clear();
+    return true;
+}
+void PipelineEditor::setParam(App& app, const std::string& pass, const std::string& name, const ParamValue& v) {
+    std::string e;
+    if (app.runtime().setParam(pass, name, v, e)) error.clear();
+    else error = e;
+}
+void PipelineEditor::writeBack(App& app) {
+    Runtime& rt = app.runtime();
+    if (!rt.pipelineDesc()) return;
+    std::string why;
+    std::optional<std::string> text = graph::patchPipelineText(rt.pipelineText(), *rt.pipelineDesc(), why);
+    if (!text) {
+        error = rt.pipelineFile() + ": not written back: " + why;
+        return;
+    }
+    std::ofstream out(rt.pipelineFile(), std::ios::binary | std::ios::trunc);
+    if (!out || !(out << *text)) error = rt.pipelineFile() + ": cannot write";
+    else error.clear(), log::info("wrote ", rt.pipelineFile());
+}
+
+namespace {
+
+// Ints apply when the slider is released: passes bake some into #defines, and a
+// program per intermediate value is a stall per frame of the drag. Floats apply live.
+bool paramWidget(const ParamDecl& decl, ParamValue& edited) {
+    const char* label = decl.name.c_str();
+    const bool bounded = decl.max > decl.min;
+    switch (decl.type) {
+        case ParamType::Bool: return ImGui::Checkbox(label, &std::get<bool>(edited));
+        case ParamType::Int: {
+            int& v = std::get<int>(edited);
+            if (!decl.intChoices.empty()) {
+                bool changed = false;
+                if (ImGui::BeginCombo(label, std::to_string(v).c_str())) {
+                    for (int c : decl.intChoices)
+                        if (ImGui::Selectable(std::to_string(c).c_str(), c == v)) v = c, changed = true;
+                    ImGui::EndCombo();
+                }
+                return changed;
+            }
+            if (bounded) ImGui::SliderInt(label, &v, int(decl.min), int(decl.max));
+            else ImGui::InputInt(label, &v);
+            return ImGui::IsItemDeactivatedAfterEdit();
+        }
+        case ParamType::Float:
+            return bounded ? ImGui::SliderFloat(label, &std::get<float>(edited), float(decl.min), float(decl.max), "%.4g")
+                           : ImGui::DragFloat(label, &std::get<float>(edited), 0.01f);
+        case ParamType::Enum: {
+            std::string& v = std::get<std::string>(edited);
+            bool changed = false;
+            if (ImGui::BeginCombo(label, v.c_str())) {
+                for (auto& c : decl.choices)
+                    if (ImGui::Selectable(c.c_str(), c == v)) v = c, changed = true;
+                ImGui::EndCombo();
+            }
+            return changed;
+        }
+        case ParamType::Color: return ImGui::ColorEdit3(label, std::get<Color3>(edited).data());
+    }
+    return false;
+}
+
+void panelParams(WindowState& state) {
+    App& app = *state.app;
+    PipelineEditor& editor = state.editor;
+    const graph::Plan* plan = app.runtime().plan();
+    const int index = plan ? plan->find(editor.selected) : -1;
+    if (index < 0) {
+        ImGui::TextDisabled("select a pass for its parameters");
+        return;
+    }
+    // A copy: a toggle below may swap the running plan, and with it this entry.
+    const graph::PlannedPass pass = plan->passes[size_t(index)];
+    ImGui::PushID("params");
+    ImGui::PushID(pass.id.c_str());
+    ImGui::Text("%s (%s)", pass.id.c_str(), pass.module.c_str());
+    ImGui::SameLine();
+    if (ImGui::SmallButton("write back")) editor.writeBack(app);
+    state.probe.item("write-back");
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("writes the edited values (only those) into %s", app.runtime().pipelineFile().c_str());
+    for (const ParamDecl& decl : pass.decl.params) {
+        const ParamValue* current = pass.params.find(decl.name);
+        if (!current) continue;
+        const std::string key = pass.id + "." + decl.name;
+        auto pending = state.pendingInts.find(key);
+        ParamValue edited = pending != state.pendingInts.end() ? pending->second : *current;
+        const bool changed = paramWidget(decl, edited);
+        state.probe.item("param:" + key);
+        if (decl.type == ParamType::Int && ImGui::IsItemActive()) state.pendingInts[key] = edited;
+        else if (pending != state.pendingInts.end() && !changed) state.pendingInts.erase(pending);
+        if (!decl.doc.empty() && ImGui::IsItemHovered()) ImGui::SetTooltip("%s", decl.doc.c_str());
+        if (changed) {
+            state.pendingInts.erase(key);
+            editor.setParam(app, pass.id, decl.name, edited);
+        }
+    }
+    ImGui::PopID();
+    ImGui::PopID();
+}
+
+void listPipelines(WindowState& state) {
+    state.pipelines.clear();
+    std::error_code ec;
+    const fs::path dir = fs::path(state.app->runtime().pipelineFile()).parent_path();
+    for (auto& e : fs::directory_iterator(dir.empty() ? fs::path(".") : dir, ec))
+        if (e.path().extension() == ".json" && e.path().filename() != "pipeline.schema.json")
+            state.pipelines.push_back(e.path().string());
+    std::sort(state.pipelines.begin(), state.pipelines.end());
+}
+
+void pipelineSwitcher(WindowState& state) {
+    App& app = *state.app;
+    const std::string current = fs::path(app.runtime().pipelineFile()).filename().string();
+    ImGui::SetNextItemWidth(-60);
+    if (ImGui::BeginCombo("##pipeline", current.c_str())) {
+        if (ImGui::IsWindowAppearing()) listPipelines(state);
+        for (const std::string& p : state.pipelines) {
+            const std::string name = fs::path(p).filename().string();
+            if (ImGui::Selectable(name.c_str(), name == current)) {
+                std::string errors;
+                if (app.runtime().loadPipeline(p, errors)) {
+                    state.editor.error.clear();  // live reload follows runtime().pipelineFile()
+                    if (name == "compare.json") state.compare.on = true;
+                } else {
+                    state.editor.error = errors;  // the running pipeline stays
+                }
+            }
+            state.probe.item("pipeline:" + name);
+        }
+        ImGui::EndCombo();
+    }
+    state.probe.item("pipeline-switcher");
+}
+
+void panelPasses(WindowState& state) {
+    App& app = *state.app;
+    PipelineEditor& editor = state.editor;
+    pipelineSwitcher(state);
+    ImGui::SameLine();
+    if (ImGui::SmallButton("graph")) state.showGraph = !state.showGraph;
+    state.probe.item("show-graph");
+    ImGui::SameLine();
+    if (ImGui::SmallButton("compare")) state.compare.on = !state.compare.on;
+    state.probe.item("show-compare");
+    if (ImGui::BeginTable("passes", 4, ImGuiTableFlags_RowBg | ImGuiTableFlags_BordersInnerV | ImGuiTableFlags_SizingFixedFit)) {
+        ImGui::TableSetupColumn("pass", ImGuiTableColumnFlags_WidthStretch);
+        ImGui::TableSetupColumn("state");
+        ImGui::TableSetupColumn("GPU ms");
+        ImGui::TableSetupColumn("CPU ms");
+        ImGui::TableHeadersRow();
+        double gpuTotal = 0, cpuTotal = 0;
+        const graph::Plan* plan = app.runtime().plan();
+        for (auto& r : app.runtime().stats()) {
+            ImGui::TableNextRow();
+            ImGui::TableNextColumn();
+            const int index = plan ? plan->find(r.id) : -1;
+            bool enabled = index >= 0 && plan->passes[size_t(index)].state != graph::PassState::Disabled;
+            ImGui::PushID(r.id.c_str());
+            if (ImGui::Checkbox("##on", &enabled))
+                editor.apply(app, [&](graph::PipelineDesc& d) {
+                    if (int i = d.find(r.id); i >= 0) d.passes[size_t(i)].enabled = enabled;
+                });
+            state.probe.item("pass-enabled:" + r.id);
+            ImGui::SameLine();
+            if (ImGui::Selectable(r.id.c_str(), editor.selected == r.id)) editor.selected = r.id;
+            state.probe.item("pass:" + r.id);
+            if (ImGui::IsItemHovered()) ImGui::SetTooltip("module %s", r.module.c_str());
+            ImGui::PopID();
+            ImGui::TableNextColumn();
+            ImGui::TextUnformatted(r.state.c_str());
+            if (!r.why.empty() && ImGui::IsItemHovered()) ImGui::SetTooltip("%s", r.why.c_str());
+            // What ran this frame costs its rolling average; a skipped, culled or disabled
+            // pass costs nothing and shows a dash, never its last figure.
+            ImGui::TableNextColumn();
+            if (r.ranThisFrame && r.gpuMs >= 0) ImGui::Text("%.2f", r.gpuMs), gpuTotal += r.gpuMs;
+            else ImGui::TextDisabled("-");
+            ImGui::TableNextColumn();
+            if (r.ranThisFrame) ImGui::Text("%.2f", r.cpuMs), cpuTotal += r.cpuMs;
+            else ImGui::TextDisabled("-");
+        }
+        ImGui::EndTable();
+        ImGui::Text("this frame: GPU %.2f ms, CPU %.2f ms", gpuTotal, cpuTotal);
+    }
+    if (!editor.error.empty()) {
+        ImGui::PushTextWrapPos(0.0f);
+        ImGui::TextColored(ImVec4(1, 0.4f, 0.4f, 1), "%s", editor.error.c_str());
+        ImGui::PopTextWrapPos();
+    }
+}
+
+void panelTextures(WindowState& state) {
+    App& app = *state.app;
+    if (ImGui::RadioButton("image: graph output", !state.mainShowsSelection)) state.mainShowsSelection = false;
+    ImGui::SameLine();
+    if (ImGui::RadioButton("selected texture", state.mainShowsSelection)) state.mainShowsSelection = true;
+    static ImGuiTextFilter filter;
+    filter.Draw("filter", 160);
+    state.probe.item("texture-filter");
+    for (auto& t : app.runtime().textures()) {
+        const std::string name = t.pass + "." + t.name;
+        if (!filter.PassFilter(name.c_str())) continue;
+        const std::string label = name + (t.internal ? " (internal)" : "") + "  " + std::to_string(t.ref.width) + "x" +
+                                  std::to_string(t.ref.height) +
+                                  (t.ref.target == GL_TEXTURE_3D ? "x" + std::to_string(t.ref.depth) : "") + " " +
+                                  gl::formatName(t.ref.format);
+        // Selecting a texture un-culls its producer (from the next frame on), as --view does.
+        if (ImGui::Selectable(label.c_str(), app.viewed == name)) app.viewed = name, state.showTexture = true;
+        state.probe.item("texture:" + name);
+    }
+    if (!app.viewed.empty() && ImGui::SmallButton("clear selection")) app.viewed.clear();
+}
+
+void panelScene(WindowState& state) {
+    App& app = *state.app;
+    auto& sim = app.scene().sim();
+    ImGui::Checkbox("paused (Space)", &app.paused);
+    state.probe.item("paused");
+    ImGui::SameLine();
+    if (ImGui::Button("step (.)")) app.singleStep = true;
+    ImGui::SameLine();
+    if (ImGui::Button("reset (R)")) app.scene().reset();
+    if (ImGui::Button("marble (M)")) sim.spawnRandom(sim::BallKind::Marble);
+    ImGui::SameLine();
+    if (ImGui::Button("fireball (F)")) sim.spawnRandom(sim::BallKind::Fireball);
+    float scale = float(app.timeScale);
+    if (ImGui::SliderFloat("time scale", &scale, 0.05f, 4.0f, "%.2fx", ImGuiSliderFlags_Logarithmic)) app.timeScale = scale;
+    ImGui::Text("t = %.2f s, %d steps this frame, %zu balls, %zu particles", app.scene().time(), app.lastSteps,
+                sim.balls().size(), sim.particles().size());
+    if (app.droppedSeconds > 0)
+        ImGui::TextDisabled("%.1f s of simulated time dropped (frames slower than %d steps)", app.droppedSeconds,
+                            App::kMaxStepsPerFrame);
+    ImGui::Separator();
+    ImGui::Text("%.1f ms per frame (%.1f fps), rendering %dx%d", state.frameMs, state.frameMs > 0 ? 1000.0 / state.frameMs : 0.0,
+                int(state.image.z * state.renderScale), int(state.image.w * state.renderScale));
+    ImGui::Checkbox("resolution follows the budget", &state.autoScale);
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("lowers the render resolution while frames take longer than the budget");
+    ImGui::SetNextItemWidth(120);
+    if (ImGui::SliderFloat("budget ms", &state.budgetMs, 16.0f, 500.0f, "%.0f")) state.scaleFloor = 0.125f;
+    if (!state.autoScale) ImGui::SliderFloat("resolution scale", &state.renderScale, 0.125f, 1.0f, "%.3f");
+    else ImGui::Text("resolution scale %.3f", state.renderScale);
+    ImGui::TextDisabled("drag a tumbler: low to move it, high to tilt it");
+}
+
+// Passes as nodes in columns by dependency depth, bindings as edges.
+void panelGraph(WindowState& state, bool* open) {
+    App& app = *state.app;
+    const graph::Plan* plan = app.runtime().plan();
+    ImGui::SetNextWindowPos(ImVec2(float(state.image.x) + 8, float(state.image.y) + 8), ImGuiCond_FirstUseEver);
+    ImGui::SetNextWindowSize(ImVec2(640, 320), ImGuiCond_FirstUseEver);
+    if (!ImGui::Begin("Graph", open) || !plan) {
+        ImGui::End();
+        return;
+    }
+    const size_t n = plan->passes.size();
+    std::vector<int> column(n, 0), row(n, 0);
+    for (size_t i = 0; i < n; ++i)  // file order is execution order: producers come first
+        for (const graph::Binding& b : plan->passes[i].bindings)
+            if (b.bound()) column[i] = std::max(column[i], column[size_t(b.producer)] + 1);
+    std::map<int, int> rowsInColumn;
+    for (size_t i = 0; i < n; ++i) row[i] = rowsInColumn[column[i]]++;
+    std::map<std::string, bool> ran;
+    for (auto& r : app.runtime().stats()) ran[r.id] = r.ranThisFrame;
+
+    ImGui::TextDisabled("green ran, blue skipped (nothing it reads changed), grey culled, red disabled; click to select");
+    const ImVec2 nodeSize(150, 46), gap(60, 18);
+    const ImVec2 origin = ImGui::GetCursorScreenPos();
+    auto nodePos = [&](size_t i) {
+        return ImVec2(origin.x + 8 + column[i] * (nodeSize.x + gap.x), origin.y + 8 + row[i] * (nodeSize.y + gap.y));
+    };
+    ImDrawList* draw = ImGui::GetWindowDrawList();
+    for (size_t i = 0; i < n; ++i)
+        for (const graph::Binding& b : plan->passes[i].bindings) {
+            if (!b.bound()) continue;
+            const ImVec2 a = nodePos(size_t(b.producer)), c = nodePos(i);
+            const ImVec2 from(a.x + nodeSize.x, a.y + nodeSize.y * 0.5f), to(c.x, c.y + nodeSize.y * 0.5f);
+            draw->AddBezierCubic(from, ImVec2(from.x + 30, from.y), ImVec2(to.x - 30, to.y), to, IM_COL32(180, 180, 190, 200), 1.5f);
+        }
+    for (size_t i = 0; i < n; ++i) {
+        const graph::PlannedPass& p = plan->passes[i];
+        const ImVec2 a = nodePos(i), b(a.x + nodeSize.x, a.y + nodeSize.y);
+        // run this frame: green; skipped (nothing it reads changed): blue; culled: grey; disabled: red.
+        ImU32 fill = p.state == graph::PassState::Disabled ? IM_COL32(110, 40, 40, 255)
+                     : p.state == graph::PassState::Culled ? IM_COL32(70, 70, 70, 255)
+                     : ran[p.id]                           ? IM_COL32(40, 110, 60, 255)
+                                                           : IM_COL32(40, 70, 120, 255);
+        draw->AddRectFilled(a, b, fill, 4.0f);
+        if (p.id == state.editor.selected) draw->AddRect(a, b, IM_COL32(255, 220, 80, 255), 4.0f, 0, 2.0f);
+        draw->AddText(ImVec2(a.x + 6, a.y + 4), IM_COL32_WHITE, p.id.c_str());
+        const std::string sub = p.module + " - " + toString(p.state);
+        draw->AddText(ImVec2(a.x + 6, a.y + 24), IM_COL32(210, 210, 210, 255), sub.c_str());
+        ImGui::SetCursorScreenPos(a);
+        ImGui::PushID(int(i));
+        if (ImGui::InvisibleButton("node", nodeSize)) state.editor.selected = p.id;
+        if (ImGui::IsItemHovered() && !p.reason.empty()) ImGui::SetTooltip("%s", p.reason.c_str());
+        state.probe.item("graph-node:" + p.id);
+        ImGui::PopID();
+    }
+    ImGui::End();
+}
+
+}  // namespace
+
+void panelErrors(const App& app, WindowState& state) {
+    auto errors = app.runtime().activeErrors();
+    if (errors.empty()) return;
+    const ImGuiIO& io = ImGui::GetIO();
+    const float x = float(state.image.x) + 8, width = std::max(200.0f, float(state.image.z) - 16);
+    ImGui::SetNextWindowPos(ImVec2(x, io.DisplaySize.y - 8), ImGuiCond_Always, ImVec2(0, 1));
+    ImGui::SetNextWindowSizeConstraints(ImVec2(width, 0), ImVec2(width, io.DisplaySize.y * 0.5f));
+    ImGui::SetNextWindowBgAlpha(0.88f);
+    ImGui::Begin("errors", nullptr, ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize);
+    ImGui::PushTextWrapPos(0.0f);  // long lines wrap at the window's edge
+    for (auto& e : errors) ImGui::TextColored(ImVec4(1, 0.45f, 0.45f, 1), "%s", e.c_str());
+    ImGui::PopTextWrapPos();
+    ImGui::End();
+}
+
+void drawSidebar(WindowState& state) {
+    App& app = *state.app;
+    const ImGuiIO& io = ImGui::GetIO();
+    const float h = io.DisplaySize.y;
+    auto place = [&](float y, float height) {
+        ImGui::SetNextWindowPos(ImVec2(0, y), ImGuiCond_FirstUseEver);
+        ImGui::SetNextWindowSize(ImVec2(float(kSidebarWidth), height), ImGuiCond_FirstUseEver);
+    };
+    place(0, h * 0.36f);
+    if (ImGui::Begin("Passes (F1 hides the panels)")) panelPasses(state);
+    ImGui::End();
+    place(h * 0.36f, h * 0.24f);
+    if (ImGui::Begin("Parameters")) panelParams(state);
+    ImGui::End();
+    place(h * 0.6f, h * 0.22f);
+    if (ImGui::Begin("Textures")) panelTextures(state);
+    ImGui::End();
+    place(h * 0.82f, h * 0.18f);
+    if (ImGui::Begin("Scene")) panelScene(state);
+    ImGui::End();
+    if (state.showGraph) panelGraph(state, &state.showGraph);
+    if (state.compare.on) {
+        state.compare.panel(app, ImGui::GetTime(), {state.image.x + 8, state.image.y + 8}, [&](const std::string& id) { state.probe.item(id); });
+        // The line, over the image; drag it (handleMouse).
+        const float x = float(state.image.x) + state.compare.split * float(state.image.z);
+        ImDrawList* fg = ImGui::GetForegroundDrawList();
+        fg->AddLine(ImVec2(x, float(state.image.y)), ImVec2(x, float(state.image.y + state.image.w)), IM_COL32(255, 255, 255, 220), 2.0f);
+        fg->AddText(ImVec2(x - 16, float(state.image.y) + 4), IM_COL32_WHITE, "A");
+        fg->AddText(ImVec2(x + 8, float(state.image.y) + 4), IM_COL32_WHITE, "B");
+        if (state.probe.on()) state.probe.widgets["compare-line"] = {x - 2, state.image.y, x + 2, state.image.y + state.image.w};
+    }
+    if (state.showTexture)
+        if (const auto t = app.runtime().namedTexture(app.viewed)) {
+            state.viewer.window(*t, &state.showTexture);
+            const glm::vec4 c = state.viewer.canvasRect();
+            if (state.probe.on()) state.probe.widgets["texture-canvas"] = {c.x, c.y, c.z, c.w};
+        }
+}
+
+namespace {
+GLuint imageTextureFor(const App& app, const WindowState& state, run::NamedTexture& named) {
+    const TextureRef* t = state.mainShowsSelection ? app.displayedTexture() : app.runtime().outputTexture();
+    if (!t) return 0;
+    named = {};
+    named.ref = *t;
+    if (state.mainShowsSelection)
+        if (const auto n = app.runtime().namedTexture(app.viewed)) named = *n;
+    return t->id;
+}
+
+}  // namespace
+
+void drawImage(WindowState& state, int fbW, int fbH) {
+    App& app = *state.app;
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glViewport(0, 0, fbW, fbH);
+    glClearColor(0.1f, 0.1f, 0.11f, 1);
+    glClear(GL_COLOR_BUFFER_BIT);
+    run::NamedTexture named;
+    if (!imageTextureFor(app, state, named)) return;
+    // The graph output as it is; a selected texture with its viewer settings, fitted.
+    ViewSettings s;
+    if (state.mainShowsSelection) {
+        s = state.viewer.settingsFor(app.viewed);
+        s.zoom = 0.0f, s.center = glm::vec2(-1.0f);
+    }
+    const glm::ivec4 rect(state.image.x, fbH - state.image.y - state.image.w, state.image.z, state.image.w);
+    if (state.compare.on) state.compare.draw(state.viewer, app, rect);
+    else state.viewer.draw(named.ref, named.depthNear, named.depthFar, s, rect);
+}
+
+}  // namespace kiln::app

@@ -1,0 +1,102 @@
+// app/window_state.hpp — what the window keeps between frames, shared by its parts:
+// the debug view's panels (debug_panels.cpp), mouse and keys (window_input.cpp), the
+// script interface (ui_probe.cpp) and the main loop with its resolution budget
+// (window.cpp).
+#pragma once
+
+#include <imgui.h>
+#include <nlohmann/json.hpp>
+
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "app/app.hpp"
+#include "app/compare_view.hpp"
+#include "app/texture_viewer.hpp"
+#include "graph/pipeline.hpp"
+
+struct GLFWwindow;
+
+namespace kiln::app {
+
+inline constexpr int kSidebarWidth = 380;  // the panels' column, left of the image
+
+// Where each widget a script may want to click is, and what the texture readout says,
+// written to --ui-probe FILE every frame (tests drive the window with xdotool).
+struct UiProbe {
+    std::string path;
+    nlohmann::json widgets = nlohmann::json::object();
+
+    bool on() const { return !path.empty(); }
+    void item(const std::string& id) {
+        if (!on() || !ImGui::IsItemVisible()) return;  // scrolled away or clipped: not clickable
+        const ImVec2 a = ImGui::GetItemRectMin(), b = ImGui::GetItemRectMax();
+        widgets[id] = {a.x, a.y, b.x, b.y};
+    }
+    // Writes `state` with the widgets seen since the last write, atomically.
+    void write(nlohmann::json state);
+};
+
+// Edits of the running pipeline: toggles recompile an edited description, parameter
+// values go through Runtime::setParam (no recompile). The file changes only on "write back".
+struct PipelineEditor {
+    std::string error;
+    std::string selected;  // pass id whose parameters are shown
+
+    bool apply(App& app, const std::function<void(graph::PipelineDesc&)>& edit);
+    void setParam(App& app, const std::string& pass, const std::string& name, const ParamValue& v);
+    // Only the edited values change in the file (key order, layout and notes stay).
+    void writeBack(App& app);
+};
+
+struct WindowState {
+    App* app = nullptr;
+    bool showDebug = true;
+    bool showTexture = false, showGraph = false;
+    bool mainShowsSelection = false;  // the image shows the selected texture, not the output
+    bool dragging = false;
+    bool draggingTumbler = false;
+    sim::DragMode dragMode = sim::DragMode::Translate;
+    double lastX = 0, lastY = 0;
+    // Where the left button went down (the callback sees it when it happens): a slow
+    // frame may poll the button only after the cursor has moved on, and what the press
+    // grabs (the compare line, a tumbler) is decided where it was pressed.
+    bool pressPending = false;
+    double pressX = 0, pressY = 0;
+    double eventX = 0, eventY = 0;  // the cursor as of the last motion event handled
+                                    // (glfwGetCursorPos is the pointer now, later events included)
+    glm::ivec4 image{0};              // where the image is, window pixels from the top left
+    TextureViewer viewer;
+    CompareView compare;
+    PipelineEditor editor;
+    // Int parameter values being dragged (applied on release), by "pass.param".
+    std::map<std::string, ParamValue> pendingInts;
+    UiProbe probe;
+    // The resolution budget: render at renderScale × the image area; with autoScale
+    // the scale follows the frame time toward budgetMs.
+    float renderScale = 1.0f;
+    bool autoScale = true;
+    float budgetMs = 100.0f;
+    double frameMs = 0.0;             // smoothed wall time per frame
+    double lastScaleChange = 0.0;
+    double msBeforeDecrease = 0.0;    // frame time before the last step down (0: none pending)
+    float scaleFloor = 0.125f;        // below this, fewer pixels stopped buying time
+    std::vector<std::string> pipelines;  // *.json beside the running pipeline
+};
+
+// debug_panels.cpp: the sidebar's panels, the error overlay, the image.
+void drawSidebar(WindowState&);
+void panelErrors(const App&, WindowState&);
+void drawImage(WindowState&, int framebufferWidth, int framebufferHeight);
+
+// window_input.cpp: keys, wheel and button events, and the left button's drags.
+void installCallbacks(GLFWwindow*);
+void handleMouse(GLFWwindow*, WindowState&);
+
+// ui_probe.cpp: what --ui-probe writes each frame, and --screenshot.
+nlohmann::json probeState(const WindowState&, uint64_t frame);
+void saveScreenshot(const std::string& path, int width, int height);
+
+}  // namespace kiln::app
