@@ -68,23 +68,27 @@ TEST_CASE("a pipeline edit changes the plan and keeps unchanged passes' textures
     CHECK(box.app.runtime().findTexture("gbuffer", "albedo")->id == albedo);
 }
 
-TEST_CASE("a rebuilt module is swapped in with its parameters kept, a broken one is refused", "[live][gl]") {
+TEST_CASE("a rebuilt module is swapped in with its parameters kept, unsaved edits included, a broken one is refused", "[live][gl]") {
     const std::string pipeline = R"({"output": "tint.color",
         "passes": [{"id": "tint", "module": "live_tint", "params": {"level": 0.25}}]})";
     const fs::path v1 = fs::path(LIVE_MODULE_BUILDS) / "tint_v1.so", v2 = fs::path(LIVE_MODULE_BUILDS) / "tint_v2.so";
     Sandbox box("module-swap", "tint.json", pipeline,
                 [&](const fs::path& root) { fs::copy_file(v1, root / "modules/libpass_live_tint.so"); });
     CHECK(box.waitFor([&] { return near(box.centre(), {1.0f, 0.25f, 0.0f}); }));
+    // An edit in the debug view, not saved to the file: the rebuild keeps it.
+    std::string error;
+    REQUIRE(box.app.runtime().setParam("tint", "level", 0.6f, error));
+    CHECK(box.waitFor([&] { return near(box.centre(), {1.0f, 0.6f, 0.0f}); }));
 
     const fs::path installed = box.root / "modules/libpass_live_tint.so";
     writeByRename(installed, slurp(v2));
-    CHECK(box.waitFor([&] { return near(box.centre(), {0.0f, 0.25f, 1.0f}); }));  // new code, same level
+    CHECK(box.waitFor([&] { return near(box.centre(), {0.0f, 0.6f, 1.0f}); }));  // new code, the edited level
     CHECK(box.app.live().moduleReloads >= 1);
 
     writeByRename(installed, "this is not a shared library");
     CHECK(box.waitFor([&] { return box.errorMentions("libpass_live_tint.so"); }));
     box.app.camera().yaw += 0.1f;
-    CHECK(near(box.centre(), {0.0f, 0.25f, 1.0f}));  // the previous module keeps running
+    CHECK(near(box.centre(), {0.0f, 0.6f, 1.0f}));  // the previous module keeps running
 }
 
 TEST_CASE("a module written in two halves or torn is retried, not reported broken, and one left truncated is", "[live][gl]") {
