@@ -1,4 +1,4 @@
-// metrics/metrics.hpp — how far an image is from a reference (SPEC §7).
+// metrics/metrics.hpp — how far an image is from a reference (README: "The reference and run time against error").
 //
 // Radiance metrics work on linear HDR RGB (before bloom and tonemapping):
 //   RMSE           √ mean over pixels and channels of (I − R)²

@@ -1,4 +1,4 @@
-// bloom — the bright part of the picture, blurred (SPEC §6.5): a bright-pass of the
+// bloom — the bright part of the picture, blurred: a bright-pass of the
 // G-buffer's emitted radiance (`color`, bound to gbuffer.emissive), then a separable
 // Gaussian of σ = radius/2 full-resolution pixels (radius 4 = the seed's 9×9 kernel).
 // It runs at HALF resolution: a compute bright-pass averages each 2×2 block into the

@@ -1,4 +1,4 @@
-// cone_trace — diffuse voxel cone tracing per pixel (SPEC §6.6, Crassin et al. 2011):
+// cone_trace — diffuse voxel cone tracing per pixel (Crassin et al. 2011):
 // N cones over the hemisphere of the G-buffer normal march through the mipped voxel
 // radiance with quadrilinear lookups; steps grow with the cone diameter. Output: the
 // indirect irradiance as a cosine-weighted mean incoming radiance (composite adds

@@ -1,4 +1,4 @@
-// reference — the ground truth the rest is measured against (SPEC §7): a progressive
+// reference — the ground truth the rest is measured against: a progressive
 // path tracer over the analytic scene the simulation holds (walls as planes, marbles,
 // fireballs and particles as spheres, tumblers as exact round cones, the lamp as the
 // sphere below the ceiling), with the rasterizer's materials. The shader

@@ -1,4 +1,4 @@
-// voxel_mip — mip chains of the voxel radiance (SPEC §6.4), compute shaders in 4³
+// voxel_mip — mip chains of the voxel radiance, compute shaders in 4³
 // workgroups, one dispatch per level.
 //
 // Outputs (both the input's res³, SizeRule::fromInput, with a full mip chain; colours
@@ -16,7 +16,7 @@
 //          (i&1, (i>>1)&1, i>>2). A cone with direction d takes three of them, chosen
 //          by sign arithmetic (x: (d.x<0, 0, 0), y: (d.y<0, 1, 0), z: (d.z<0, 0, 1)),
 //          weighted by d² — three fetches from one sampler, no branch (see
-//          PERFORMANCE.md: six samplers behind a ?: cost ~7 fetches on llvmpipe).
+//          docs/performance.md: six samplers behind a ?: cost ~7 fetches on llvmpipe).
 //          The sampler must clamp coordinates half a texel inside the octant
 //          (shaders/cone_trace/voxels.glsl does).
 //   fixed_cones  (mode = fixed_cones) the aniso chains blended per direction of the

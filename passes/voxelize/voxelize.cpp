@@ -1,5 +1,5 @@
 // voxelize — the scene's outgoing radiance in a res³ volume over the box [-1,1]³
-// (SPEC §6.3): direct light from the lamp (hard shadow from `shadow_map`, no PCF; the
+// direct light from the lamp (hard shadow from `shadow_map`, no PCF; the
 // same lampLight() as composite) plus emission, from the Cornell box, the lamp dome,
 // the tumblers (low-poly LOD), the fireballs and the particles (marbles on request).
 // The lamp dome is voxelized as an occluder, its emission scaled by `lamp_emission`

@@ -1,6 +1,6 @@
 // The lamp's shadow projection, shared by the shadow pass and everything that reads
 // its map. A perspective view from the lamp centre (above the ceiling, outside the
-// box) looking straight down: one 2D map covers the box below the lamp (SPEC §6.2).
+// box) looking straight down: one 2D map covers the box below the lamp.
 // 140° field of view: the floor and every caster are inside; the topmost corners of
 // the walls (y > 0.85, receivers only, already shaded by the lamp's directional
 // falloff) fall outside and read as lit.

@@ -82,7 +82,7 @@ void World::stepBall(int bi, double dt) {
         if (std::abs(x1[k]) <= limit) continue;
         // Time-symmetric bounce: a step that would cross the wall becomes the time
         // reverse of the step that came in, v₁ = −e·v₀, x₁ = x₀ + v₁Δt. With e = 1 it
-        // keeps E′ = ½v² + g·y − ½gΔt·v_y exactly (PHYSICS.md), never lets the ball
+        // keeps E′ = ½v² + g·y − ½gΔt·v_y exactly (docs/physics.md §4), never lets the ball
         // through (it moves away from the wall from inside), and needs no time of impact.
         const double wall = x1[k] > 0 ? limit : -limit;
         v1[k] = -rest.ballBox * v0[k];

@@ -11,7 +11,7 @@
 namespace kiln::sim::detail {
 
 inline constexpr double kPi = 3.14159265358979323846;
-inline constexpr double kFireRate = 400.0;  // particles per second per fireball (SPEC §5)
+inline constexpr double kFireRate = 400.0;  // particles per second per fireball (docs/physics.md §6)
 inline constexpr double kFireLife = 0.45;
 
 // [r]× as a column-major glm matrix: skew(r) * v == cross(r, v).

@@ -12,7 +12,7 @@
 //
 // Seed mode keeps the seed's model: centre of mass at O, the restoring impulse −Δt·d at
 // one unit above O, and rolling imposed as a velocity impulse each sub-step
-// (semi-implicit Euler). Both modes then apply SPEC §4.1's friction and sleep.
+// (semi-implicit Euler). Both modes then apply docs/physics.md §3's friction and sleep.
 #include "internal.hpp"
 
 namespace kiln::sim {
@@ -142,11 +142,11 @@ void World::stepTumblerSeed(int i, double dt) {
     const Quat dq(0.0, w.x, w.y, w.z);
     t.orientation = glm::normalize(t.orientation + (dt * 0.5) * (dq * t.orientation));
     t.position = g - t.rotation() * comLocal_;
-    t.position.y = -1.0 + b;  // stays on the floor (SPEC §4.1)
+    t.position.y = -1.0 + b;  // stays on the floor (docs/physics.md §3)
 }
 
 void World::applyFriction(Tumbler& t, double dt) const {
-    // SPEC §4.1: friction damps rocking and rolling, |ω| falls by μg·Δt/b per sub-step.
+    // docs/physics.md §3: friction damps rocking and rolling, |ω| falls by μg·Δt/b per sub-step.
     const auto& ph = scene_.physics;
     if (ph.friction <= 0) return;
     Vec3& w = t.angularVelocity;

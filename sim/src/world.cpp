@@ -15,7 +15,7 @@ void World::reset(const Scene& scene) {
     if (scene.physics.tumblerMode == TumblerMode::Accurate) {
         // A weighted base: the centre of mass sits h below O, and the inertia about it
         // is I_G = I_O − m·y_G², the uniform body's inertia moved from O to its own
-        // centroid by the parallel-axis theorem — the I_G of PHYSICS.md's rocking example.
+        // centroid by the parallel-axis theorem — the I_G of docs/physics.md's rocking example.
         comLocal_ = Vec3(0, -scene.physics.ballastH, 0);
         inertiaCom_ = mass_.inertiaCom;
     } else {

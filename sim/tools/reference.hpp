@@ -1,5 +1,5 @@
 // Independent references for the benchmark (not the sim's integrator): the exact rocking
-// period of a ballasted round cone rolling on its lower sphere by quadrature (PHYSICS.md),
+// period of a ballasted round cone rolling on its lower sphere by quadrature (docs/physics.md §3),
 // and the sim's measured period by Hermite-interpolated zero crossings.
 #pragma once
 

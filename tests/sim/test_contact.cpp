@@ -108,7 +108,7 @@ TEST_CASE("the four-sphere approximation never under-estimates, its error measur
     }
     INFO("near-contact poses " << n << ", mean over-estimate " << sumErr / std::max(n, 1) << ", max " << maxErr);
     // Each end sphere is a subset of its body: the approximation can only be larger
-    // (1e-12: rounding). It is visibly larger on these poses (PHYSICS.md: mm to cm).
+    // (1e-12: rounding). It is visibly larger on these poses (docs/physics.md §4: mm to cm).
     CHECK(worstBelow > -1e-12);
     CHECK(n > 100);
     CHECK(maxErr > 1e-3);

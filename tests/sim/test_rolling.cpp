@@ -1,6 +1,6 @@
 // Exact rolling (accurate mode) against references computed another way: the planar
 // rocking equation integrated by a separate plain RK4 and the period by quadrature
-// (PHYSICS.md), and the invariants of 3D frictionless rolling (energy, Jellett).
+// (docs/physics.md §3), and the invariants of 3D frictionless rolling (energy, Jellett).
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -17,7 +17,7 @@ namespace {
 constexpr double kDeg = M_PI / 180.0;
 
 // The planar rocking of a ballasted round cone rolling on its lower sphere (radius R,
-// centre of mass h below its centre), written from PHYSICS.md independently of the sim:
+// centre of mass h below its centre), written from docs/physics.md independently of the sim:
 //   J(θ)·θ̈ + m·R·h·sin θ·θ̇² + m·g·h·sin θ = 0,   J(θ) = I_G + m(R² + h² − 2Rh·cos θ).
 struct Planar {
     double m, R, h, IG, g;
@@ -117,10 +117,10 @@ Planar planarOf(const World& w) {
 
 }  // namespace
 
-TEST_CASE("rocking reference: quadrature and a plain RK4 agree with PHYSICS.md", "[sim][rolling]") {
+TEST_CASE("rocking reference: quadrature and a plain RK4 agree with docs/physics.md", "[sim][rolling]") {
     const World w(rockingScene(0.1, 1.0 / 240, 4));
     const Planar p = planarOf(w);
-    // PHYSICS.md's values are given to 6 significant digits: 5e-6 relative.
+    // docs/physics.md's values are given to 6 significant digits: 5e-6 relative.
     CHECK(p.quadraturePeriod(1e-6) == Approx(1.94025).epsilon(5e-6));
     CHECK(p.quadraturePeriod(30 * kDeg) == Approx(2.00225).epsilon(5e-6));
     CHECK(p.quadraturePeriod(90 * kDeg) == Approx(2.53733).epsilon(5e-6));
@@ -170,7 +170,7 @@ TEST_CASE("accurate mode: the period converges to the exact one at fourth order"
 TEST_CASE("3D frictionless rolling keeps energy and Jellett's quantity (tilt + spin, 20 s)", "[sim][rolling]") {
     // A tumbler tilted 30° and spun at 12 rad/s (plus some rocking) precesses and
     // nutates, rolling in small loops (it stays clear of the walls). The exact flow conserves the energy E = ½ωᵀAω + m·g·G_y and
-    // Jellett's J = L_G·(G − P) (PHYSICS.md: the Routh sphere is integrable); RK4 leaves
+    // Jellett's J = L_G·(G − P) (docs/physics.md §3: the Routh sphere is integrable); RK4 leaves
     // an O(Δt⁴) drift. Bounds (measured ~1e-11 at the shipped Δt): 1e-8 of the kinetic
     // energy scale for E, 1e-8 of |L_G|·|G − P| for J; at Δt = 1/60 with one sub-step
     // (measured ~1e-6), 1e-4.

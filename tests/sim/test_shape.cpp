@@ -137,12 +137,12 @@ TEST_CASE("SDF and gradient stay finite on the axis and at the sphere centres", 
 TEST_CASE("the seed's threshold slip is fixed: 1 cm above the top reads +1 cm", "[sim][shape]") {
     RoundCone s;
     CHECK(s.upperCentre() == Approx(0.292380440016).epsilon(1e-11));
-    // With the seed's y_t/tan α threshold this read −0.062 (PHYSICS.md).
+    // With the seed's y_t/tan α threshold this read −0.062 (docs/physics.md §1).
     CHECK(s.sdf(Vec3(0, s.top() + 0.01, 0)) == Approx(0.01).margin(1e-12));
     CHECK(s.sdf(Vec3(0, s.top() - 0.01, 0)) == Approx(-0.01).margin(1e-12));
 }
 
-TEST_CASE("mass properties: closed form = quadrature = PHYSICS.md's table", "[sim][shape]") {
+TEST_CASE("mass properties: closed form = quadrature = docs/physics.md's table", "[sim][shape]") {
     RoundCone s;
     MassProperties exact = s.massProperties(1.0), quad = s.integratedMassProperties(1.0);
     auto rel = [](double a, double b) { return std::abs(a - b) / std::abs(b); };
@@ -153,7 +153,7 @@ TEST_CASE("mass properties: closed form = quadrature = PHYSICS.md's table", "[si
         CHECK(rel(quad.inertiaOrigin[k], exact.inertiaOrigin[k]) < 1e-9);
         CHECK(rel(quad.inertiaCom[k], exact.inertiaCom[k]) < 1e-9);
     }
-    // Independent values (PHYSICS.md), given to 12 digits.
+    // Independent values (docs/physics.md §2), given to 12 digits.
     CHECK(rel(exact.volume, 0.0427893001736) < 1e-10);
     CHECK(rel(exact.density, 23.3703284686) < 1e-10);
     CHECK(rel(exact.comY, 0.0521160345185) < 1e-10);

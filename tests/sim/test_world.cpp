@@ -110,7 +110,7 @@ TEST_CASE("accurate mode: the small rocking period matches 2π/ω₀ within 1 %"
     const double m = 1.0, g = s.physics.gravity, h = 0.05, b = 0.2;
     const double ic = w.massProperties().inertiaCom.x;
     const double expected = 2.0 * M_PI * std::sqrt((ic + m * (b - h) * (b - h)) / (m * g * h));
-    REQUIRE(expected == Approx(1.94025).epsilon(1e-4));  // PHYSICS.md's value
+    REQUIRE(expected == Approx(1.94025).epsilon(1e-4));  // docs/physics.md's value
     // Upward zero crossings of the tilt; the period is their mean spacing.
     std::vector<double> crossings;
     double prev = tiltAboutZ(w.tumblers()[0]);
@@ -133,7 +133,7 @@ TEST_CASE("a uniform tumbler tilted 5 degrees falls over, a ballasted one rights
         // Rolling friction: its constant deceleration μg/b must stay below gravity's
         // torque at 5° (0.5 rad/s² for the uniform toy), or friction holds it up.
         s.physics.friction = 0.005;
-        // Uniform: the centre of mass 0.0521 above O (PHYSICS.md).
+        // Uniform: the centre of mass 0.0521 above O (docs/physics.md §2).
         s.physics.ballastH = ballasted ? 0.05 : -0.0521160345185;
         s.tumblers.push_back({{0.0, 0.0}, {0.0, 5.0 * M_PI / 180.0}, {1, 0, 0}});
         World w(s);
@@ -319,7 +319,7 @@ TEST_CASE("exact tumbler separation: known poses", "[sim][world]") {
 }
 
 TEST_CASE("accurate mode: the period at 30 degrees matches the exact quadrature", "[sim][world]") {
-    // PHYSICS.md: T(30°) = 2.00225 s for h = 0.05 (from the full nonlinear equation).
+    // docs/physics.md §3: T(30°) = 2.00225 s for h = 0.05 (from the full nonlinear equation).
     // 1 %: the integrator's period error is second order, −(ωΔt)²/24 ≈ 1e-5 here; the
     // rest is the zero-crossing interpolation (≤ Δt/T ≈ 0.2 % per crossing, averaged).
     Scene s = emptyScene();
@@ -420,7 +420,7 @@ TEST_CASE("tumbler against tumbler: both methods push them apart", "[sim][world]
         REQUIRE(w.allFinite());
         // Exact: pushed apart within the step that found the overlap, so only the
         // sub-steps' motion after the push remains (≤ |v|·Δt ≈ 5 mm). The four-sphere
-        // test misses side-on-side overlaps (PHYSICS.md: up to ~3 cm).
+        // test misses side-on-side overlaps (docs/physics.md §4: centimetres).
         CHECK(worst > (method == TumblerContact::Exact ? -0.005 : -0.04));
         CHECK(w.tumblers()[0].position.x < w.tumblers()[1].position.x);
     }

@@ -22,7 +22,7 @@
 //       "max_substeps": 256,        // adaptive ceiling for fast bodies, ≥ 1 (≤ substeps: off,
 //                                   //   allowed only with dt/substeps ≤ 1/240 s)
 //       "gravity": 9.81,            // m/s², [0, 100]
-//       "friction": 0.005,          // μ of the rocking damping (SPEC §4.1), [0, 10]
+//       "friction": 0.005,          // μ of the rocking damping (docs/physics.md §3), [0, 10]
 //       "wall_decay": 0.5,          // tumbler velocity kept after hitting a wall, [0, 1]
 //       "tumbler_mode": "seed" | "accurate",         // restoring impulse | weighted base
 //       "tumbler_contact": "four_spheres" | "exact", // tumbler-vs-tumbler method
@@ -32,7 +32,7 @@
 //         "ball_box": 1,            //   honoured exactly: v_n after = −e · v_n before
 //         "ball_lamp": 1,           //   (relative normal velocity at the contact point;
 //         "ball_ball": 1,           //   tumblers answer with their rolling-constrained
-//         "ball_tumbler": 1,        //   effective mass). Balls: 1 (SPEC §4.2, no loss).
+//         "ball_tumbler": 1,        //   effective mass). Balls: 1 (docs/physics.md §4, no loss).
 //         "tumbler_tumbler": 0.5,   //   Tumbler vs wall: "wall_decay" above.
 //         "tumbler_floor": 0 }      //   A toppled tumbler's side/upper sphere landing.
 //     },

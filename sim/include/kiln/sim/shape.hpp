@@ -3,7 +3,7 @@
 // (0, y_t, 0), y_t = (b − t)/sin α), its exact signed distance and gradient, and its
 // mass properties in closed form (spherical caps + frustum) and by quadrature.
 //
-// SDF (SPEC §3.3, Quilez's sdRoundCone): with r = √(x²+z²), k = y·cos α − r·sin α:
+// SDF (docs/physics.md §1, Quilez's sdRoundCone): with r = √(x²+z²), k = y·cos α − r·sin α:
 //   k < 0            → lower sphere   √(r² + y²) − b
 //   k > y_t·cos α    → upper sphere   √(r² + (y − y_t)²) − t     ([fix]: not y_t / tan α)
 //   otherwise        → side           y·sin α + r·cos α − b
@@ -40,7 +40,7 @@ public:
     double upperCentre() const { return yt_; }  // y_t
     double top() const { return yt_ + t_; }
 
-    // Radius of the solid at height y (SPEC §3.1); 0 outside [−b, y_t + t].
+    // Radius of the solid at height y (docs/physics.md §1); 0 outside [−b, y_t + t].
     double radiusAt(double y) const;
     // Exact signed distance in local space (negative inside).
     double sdf(const Vec3& p) const;

@@ -11,7 +11,7 @@
 //   if (world.bodiesVersion() != seen) upload tumblers()/balls() (the host writes its
 //   own instance records from them); likewise particlesVersion() for particles().
 //
-// Model (SPEC §4): a tumbler's lower-sphere centre O stays at y = −1 + b and it rolls
+// Model (docs/physics.md): a tumbler's lower-sphere centre O stays at y = −1 + b and it rolls
 // without slipping; "seed" mode puts the centre of mass at O and adds the seed's
 // restoring impulse, "accurate" mode puts it ballast_h below O so gravity rights it.
 // Balls (marbles with gravity, fireballs without) reflect without loss off the box,
@@ -95,7 +95,7 @@ struct Particle {
     double life = 0.0, maxLife = 1.0;  // seconds left / at birth
     double size = 0.01;                // radius at birth
     ParticleKind kind = ParticleKind::Fire;
-    // Current radius and emitted colour (SPEC §5: they follow the remaining life).
+    // Current radius and emitted colour (docs/physics.md §6: they follow the remaining life).
     double radius() const;
     Vec3 emission() const;
 };
@@ -164,7 +164,7 @@ public:
 
     // Sphere-traces the ray against every tumbler; the nearest hit wins.
     std::optional<RayHit> raycastTumblers(const Vec3& origin, const Vec3& direction) const;
-    // A hit below the centre of mass translates, above rotates (SPEC §4.4).
+    // A hit below the centre of mass translates, above rotates (docs/physics.md §4, picking).
     DragMode beginDrag(const RayHit& hit);
     // Translate: the tumbler follows the ray's intersection with the plane y = s_y.
     void dragTo(const Vec3& rayOrigin, const Vec3& rayDirection);
@@ -200,7 +200,7 @@ public:
     double rollingInverseMass(int i, const Vec3& p, const Vec3& n) const;
     // Mechanical energy of tumbler i (rolling kinetic ½ωᵀAω + m·g·G_y, floor at y = −1
     // is not subtracted) and Jellett's quantity L_G·(G − P) = L_P·(G − P), conserved by
-    // frictionless rolling of a body of revolution on a sphere base (PHYSICS.md).
+    // frictionless rolling of a body of revolution on a sphere base (docs/physics.md §3).
     double tumblerEnergy(int i) const;
     double tumblerJellett(int i) const;
     // Σ tumblerEnergy + Σ ball mass × ballEnergy (the balls' modified energy E′).
@@ -223,7 +223,7 @@ public:
     // E′ = ½|v|² + g·y − ½·g·Δt·v_y with Δt the sub-step in effect (the scene's dt /
     // substeps unless adaptive sub-steps are running; gravity-free balls: ½|v|²).
     // Semi-implicit Euler keeps it exactly between bounces, and the time-symmetric
-    // wall bounce keeps it exactly across them (PHYSICS.md).
+    // wall bounce keeps it exactly across them (docs/physics.md §4).
     double ballEnergy(int ball) const;
 
     // Diagnostics for tests and `kiln-sim run`.
