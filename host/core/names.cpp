@@ -1,5 +1,7 @@
 #include "kiln/names.hpp"
 
+#include "kiln/json_text.hpp"
+
 #include <algorithm>
 #include <cctype>
 
@@ -34,10 +36,7 @@ int editDistance(std::string_view a, std::string_view b) {
     return prev[m];
 }
 
-std::string elide(std::string_view s, size_t max) {
-    if (s.size() <= max) return std::string(s);
-    return std::string(s.substr(0, max)) + "…(+" + std::to_string(s.size() - max) + " bytes)";
-}
+std::string elide(std::string_view s, size_t max) { return json_text::elide(s, max); }
 
 namespace {
 // Names in suggestions: shown at most this long.

@@ -21,15 +21,10 @@ std::string SceneError::toString(const std::string& file) const {
 
 namespace {
 
-// A message quotes at most this much of a value: a 10 MB array as a "radius" gives a
-// one-line error, not a 10 MB one.
-std::string elide(const std::string& s, size_t max = 60) {
-    if (s.size() <= max) return s;
-    return s.substr(0, max - 3) + "...";
-}
-// The value as the file wrote it, elided (nesting is bounded before anything is parsed,
-// so dump() cannot recurse deeply).
-std::string shown(const Json& v) { return elide(v.dump()); }
+// The value as the file wrote it, at most 60 bytes of it (a 10 MB array as a "radius"
+// gives a one-line error); nesting is bounded before anything is parsed, so dump()
+// cannot recurse deeply.
+std::string shown(const Json& v) { return json_text::elide(v.dump(), 60); }
 
 const char* typeName(const Json& j) {
     switch (j.type()) {
@@ -125,7 +120,7 @@ struct Reader {
         known.insert("note");
         known.insert("$schema");
         for (auto& [k, v] : j.items())
-            if (!known.count(k)) return fail(at(elide(k)), "unknown key");
+            if (!known.count(k)) return fail(at(json_text::elide(k, 60)), "unknown key");
         return true;
     }
 };
@@ -211,7 +206,7 @@ public:
     std::string path() const {
         std::string p;
         for (const Frame& f : frames_)
-            p = f.array ? p + "[" + std::to_string(f.index) + "]" : (p.empty() ? elide(f.key) : p + "." + elide(f.key));
+            p = f.array ? p + "[" + std::to_string(f.index) + "]" : (p.empty() ? json_text::elide(f.key, 60) : p + "." + json_text::elide(f.key, 60));
         return p;
     }
 
@@ -251,7 +246,7 @@ bool parseJson(const std::string& text, Json& root, SceneError& error) {
         const size_t p = what.find("parse error");
         const size_t colon = p == std::string::npos ? std::string::npos : what.find(": ", p);
         error = {"", "line " + std::to_string(line) + ", column " + std::to_string(column) + ": " +
-                         elide(colon == std::string::npos ? what : what.substr(colon + 2), 160)};
+                         json_text::elide(colon == std::string::npos ? what : what.substr(colon + 2), 160)};
         return false;
     } catch (const Json::exception& e) {
         // out_of_range 406 "number overflow parsing '1e999'": locate the quoted token.
@@ -268,7 +263,7 @@ bool parseJson(const std::string& text, Json& root, SceneError& error) {
             }
         }
         if (e.id == 406) what += " (beyond the range of a double)";
-        error = {tracker.path(), where + elide(what, 160)};
+        error = {tracker.path(), where + json_text::elide(what, 160)};
         return false;
     }
     if (!root.is_object()) {
@@ -448,7 +443,7 @@ bool parseScene(const std::string& text, Scene& out, SceneError& error) {
     try {
         return readScene(root, out, error);
     } catch (const std::exception& e) {  // no library exception crosses the loader
-        error = {"", std::string("cannot read the scene: ") + elide(e.what(), 160)};
+        error = {"", std::string("cannot read the scene: ") + json_text::elide(e.what(), 160)};
         return false;
     }
 }

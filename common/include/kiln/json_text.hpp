@@ -1,7 +1,7 @@
 // kiln/json_text.hpp — what the JSON loaders (pipeline files in host/graph, scene files
 // in sim/) need from the raw text before and beside nlohmann's parser: where a byte is
-// (line and column, for messages), whether the nesting stays bounded, and the text itself
-// read with a bound. Header-only and GL-free, so the simulation library can use it
+// (line and column, for messages), whether the nesting stays bounded, the text itself
+// read with a bound, and how much of a value a message quotes. Header-only and GL-free, so the simulation library can use it
 // without depending on the host.
 #pragma once
 
@@ -13,6 +13,13 @@
 #include <string_view>
 
 namespace kiln::json_text {
+
+// User text quoted in a message, cut to `max` bytes: "abc…(+99994 bytes)". Keeps every
+// message short whatever a file holds (a 10 MB array as a radius, a 1 MB id).
+inline std::string elide(std::string_view s, size_t max) {
+    if (s.size() <= max) return std::string(s);
+    return std::string(s.substr(0, max)) + "…(+" + std::to_string(s.size() - max) + " bytes)";
+}
 
 // 1-based line and column of byte `offset` (clamped to the text).
 inline void lineColumn(std::string_view text, size_t offset, int& line, int& column) {
