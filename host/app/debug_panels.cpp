@@ -272,9 +272,14 @@ void panelScene(WindowState& state) {
 void panelGraph(WindowState& state, bool* open) {
     App& app = *state.app;
     const graph::Plan* plan = app.runtime().plan();
-    ImGui::SetNextWindowPos(ImVec2(float(state.image.x) + 8, float(state.image.y) + 8), ImGuiCond_FirstUseEver);
-    ImGui::SetNextWindowSize(ImVec2(640, 320), ImGuiCond_FirstUseEver);
-    if (!ImGui::Begin("Graph", open) || !plan) {
+    // Along the bottom, as wide as the window allows: the whole graph fits (nodes narrow to
+    // fit their columns), none is clipped off the window's edge, and the Passes panel's
+    // "graph" button that closes it stays uncovered.
+    const ImGuiIO& io = ImGui::GetIO();
+    const ImVec2 size(std::min(900.0f, io.DisplaySize.x - 16), std::min(260.0f, io.DisplaySize.y * 0.5f));
+    ImGui::SetNextWindowPos(ImVec2(8, io.DisplaySize.y - size.y - 8), ImGuiCond_FirstUseEver);
+    ImGui::SetNextWindowSize(size, ImGuiCond_FirstUseEver);
+    if (!ImGui::Begin("Graph", open, ImGuiWindowFlags_HorizontalScrollbar) || !plan) {
         ImGui::End();
         return;
     }
@@ -288,8 +293,11 @@ void panelGraph(WindowState& state, bool* open) {
     std::map<std::string, bool> ran;
     for (auto& r : app.runtime().stats()) ran[r.id] = r.ranThisFrame;
 
-    ImGui::TextDisabled("green ran, blue skipped (nothing it reads changed), grey culled, red disabled; click to select");
-    const ImVec2 nodeSize(150, 46), gap(60, 18);
+    ImGui::TextWrapped("green ran, blue skipped (nothing it reads changed), grey culled, red disabled; click to select");
+    const int columns = n ? *std::max_element(column.begin(), column.end()) + 1 : 1;
+    const float perColumn = (ImGui::GetContentRegionAvail().x - 16) / float(columns);
+    const float nodeWidth = std::clamp(perColumn * 0.78f, 90.0f, 150.0f);
+    const ImVec2 nodeSize(nodeWidth, 46), gap(std::max(16.0f, std::min(60.0f, perColumn - nodeWidth)), 18);
     const ImVec2 origin = ImGui::GetCursorScreenPos();
     auto nodePos = [&](size_t i) {
         return ImVec2(origin.x + 8 + column[i] * (nodeSize.x + gap.x), origin.y + 8 + row[i] * (nodeSize.y + gap.y));
@@ -312,9 +320,11 @@ void panelGraph(WindowState& state, bool* open) {
                                                            : IM_COL32(40, 70, 120, 255);
         draw->AddRectFilled(a, b, fill, 4.0f);
         if (p.id == state.editor.selected) draw->AddRect(a, b, IM_COL32(255, 220, 80, 255), 4.0f, 0, 2.0f);
+        draw->PushClipRect(a, b, true);  // a narrow node cuts its labels, not its neighbours
         draw->AddText(ImVec2(a.x + 6, a.y + 4), IM_COL32_WHITE, p.id.c_str());
         const std::string sub = p.module + " - " + toString(p.state);
         draw->AddText(ImVec2(a.x + 6, a.y + 24), IM_COL32(210, 210, 210, 255), sub.c_str());
+        draw->PopClipRect();
         ImGui::SetCursorScreenPos(a);
         ImGui::PushID(int(i));
         if (ImGui::InvisibleButton("node", nodeSize)) state.editor.selected = p.id;

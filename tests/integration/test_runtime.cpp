@@ -149,7 +149,11 @@ TEST_CASE("a pass that did not run this frame reports no cost this frame", "[run
         INFO(r.id << " " << r.state);
         CHECK(r.state == "skipped");
         CHECK_FALSE(r.ranThisFrame);
+        CHECK(r.skippedFrames == 1);
     }
+    // No execute() ran, so nothing was spent inside the passes; the frame's own CPU cost
+    // is the graph's bookkeeping only.
+    CHECK(f.app.runtime().lastFrameCost().passesMs == 0.0);
 }
 
 TEST_CASE("textures beyond the budget or the GL limits are a named error and the running plan stays",

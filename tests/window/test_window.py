@@ -188,7 +188,8 @@ try:
     # 4. Toggle a pass off.
     click("pass-enabled:bloom")
     p = wait_for(lambda p: p["passes"]["bloom"]["state"] == "disabled", "bloom disabled")
-    check(True, "bloom's checkbox disables it")
+    others = [k for k, v in p["passes"].items() if k != "bloom" and v["state"] == "disabled"]
+    check(not others, "bloom's checkbox disables bloom and nothing else (also disabled: %s)" % others)
 
     # 5. Write back: only the edited values change in the file.
     click("write-back")
@@ -206,7 +207,11 @@ try:
     # 6. The graph view.
     click("show-graph")
     p = wait_for(lambda p: "graph-node:gbuffer" in p["widgets"], "the graph view")
-    check(True, "the graph view shows a node per pass")
+    missing = [k for k in p["passes"] if "graph-node:" + k not in p["widgets"]]
+    check(not missing, "the graph view shows a node per pass (missing: %s)" % missing)
+    screenshot("graph.png")
+    click("show-graph")  # and the same button closes it
+    p = wait_for(lambda p: not any(w.startswith("graph-node:") for w in p["widgets"]), "the graph view closed")
 
     # 7. Switch pipeline to voxels.json without a restart.
     click("pipeline-switcher")
@@ -257,8 +262,11 @@ try:
         sh("xdotool", "mousemove", "--window", WINDOW, str(int(x - step * (x - (ix + iw // 4)) / 5)), str(y))
         frames_later(1)
     sh("xdotool", "mouseup", "1")
-    p = wait_for(lambda p: abs(p["compare"]["split"] - 0.25) < 0.03, "the line at a quarter")
-    check(True, "dragging the compare line moves it to %.3f" % p["compare"]["split"])
+    wait_for(lambda p: abs(p["compare"]["split"] - 0.25) < 0.03, "the line at a quarter")
+    frames_later()
+    p = probe()
+    check(abs(p["compare"]["split"] - 0.25) < 0.03,
+          "dragging the compare line to a quarter leaves it there after the button is up: %.3f" % p["compare"]["split"])
     screenshot("compare.png")
 
 finally:

@@ -9,8 +9,8 @@
 //   A pass owns code and shaders only: the host owns its textures, its parameter
 //   values and everything that must survive a reload of the module.
 //
-// WRITING ONE (passes/<name>/, two files, then re-run CMake once: `cmake build` — the
-// pass folders are found when CMake configures)
+// WRITING ONE (passes/<name>/, two files; the next `cmake --build build` finds the new
+// folder and re-runs CMake by itself)
 //   passes/<name>/CMakeLists.txt:   kiln_add_pass(<name> <name>.cpp)
 //   passes/<name>/<name>.cpp:
 //
