@@ -1,12 +1,15 @@
 // Exact rolling (accurate mode) against references computed another way: the planar
 // rocking equation integrated by a separate plain RK4 and the period by quadrature
-// (docs/physics.md §3), and the invariants of 3D frictionless rolling (energy, Jellett).
+// (docs/physics.md §3; the quadrature and the period measurement are sim/tools/
+// reference.hpp's, which the benchmark uses too), and the invariants of 3D frictionless
+// rolling (energy, Jellett).
 #include <catch2/catch.hpp>
 
 #include <cmath>
 #include <vector>
 
 #include "kiln/sim/world.hpp"
+#include "reference.hpp"  // sim/tools: the quadrature period and the measured one
 #include "support.hpp"
 
 using namespace kiln::sim;
@@ -25,19 +28,8 @@ struct Planar {
     double accel(double th, double om) const {
         return -(m * R * h * std::sin(th) * om * om + m * g * h * std::sin(th)) / J(th);
     }
-    // T(θ₀) = 4∫₀^{π/2} √(J(θ)/(mgh)) / √(1 − k² sin²φ) dφ, sin(θ/2) = k sin φ: the
-    // integrand is smooth and π-periodic in φ and even about π/2, so the trapezoidal rule
-    // over [0, π] converges spectrally (T = 2∫₀^π ...).
-    double quadraturePeriod(double th0) const {
-        const double k = std::sin(0.5 * th0);
-        const int n = 4096;
-        double sum = 0.0;
-        for (int i = 0; i < n; ++i) {
-            const double phi = M_PI * i / n, sp = k * std::sin(phi);
-            sum += std::sqrt(J(2.0 * std::asin(sp)) / (m * g * h)) / std::sqrt(1.0 - sp * sp);
-        }
-        return 2.0 * sum * (M_PI / n);
-    }
+    // T(θ₀) by quadrature: sim/tools/reference.hpp (the benchmark's reference too).
+    double quadraturePeriod(double th0) const { return reference::rockingPeriod(m, R, h, IG, g, th0); }
     // Plain RK4 from rest at θ₀ until θ crosses 0 (a quarter period by symmetry), the
     // crossing located by cubic Hermite interpolation of (θ, θ̇) on the last step.
     double rk4Period(double th0, double step) const {
@@ -49,32 +41,12 @@ struct Planar {
             const double k4t = om + step * k3o, k4o = accel(th + step * k3t, k4t);
             const double th1 = th + step / 6.0 * (k1t + 2 * k2t + 2 * k3t + k4t);
             const double om1 = om + step / 6.0 * (k1o + 2 * k2o + 2 * k3o + k4o);
-            if (th1 <= 0.0) {
-                double lo = 0.0, hi = 1.0;
-                for (int it = 0; it < 80; ++it) {
-                    const double s = 0.5 * (lo + hi);
-                    const double v = (2 * s * s * s - 3 * s * s + 1) * th + (s * s * s - 2 * s * s + s) * step * om +
-                                     (-2 * s * s * s + 3 * s * s) * th1 + (s * s * s - s * s) * step * om1;
-                    (v > 0.0 ? lo : hi) = s;
-                }
-                return 4.0 * (t + 0.5 * (lo + hi) * step);
-            }
+            // A downward crossing of θ is an upward one of −θ.
+            if (th1 <= 0.0) return 4.0 * reference::hermiteRoot(t, step, -th, -om, -th1, -om1);
             th = th1, om = om1, t += step;
         }
     }
 };
-
-// Root of the cubic Hermite interpolant of (y, y') over [t0, t0 + dt] (y0 < 0 ≤ y1).
-double hermiteRoot(double t0, double dt, double y0, double d0, double y1, double d1) {
-    double lo = 0.0, hi = 1.0;
-    for (int it = 0; it < 80; ++it) {
-        const double s = 0.5 * (lo + hi);
-        const double v = (2 * s * s * s - 3 * s * s + 1) * y0 + (s * s * s - 2 * s * s + s) * dt * d0 +
-                         (-2 * s * s * s + 3 * s * s) * y1 + (s * s * s - s * s) * dt * d1;
-        (v < 0.0 ? lo : hi) = s;
-    }
-    return t0 + 0.5 * (lo + hi) * dt;
-}
 
 Scene rockingScene(double amplitude, double dt, int substeps) {
     Scene s;
@@ -93,21 +65,9 @@ Scene rockingScene(double amplitude, double dt, int substeps) {
 // frames (fourth order, so it does not mask the integrator's own error).
 double kilnPeriod(double amplitude, double dt, int substeps, double periods = 4.2) {
     World w(rockingScene(amplitude, dt, substeps));
-    auto tilt = [&] {
-        const Vec3 a = w.tumblers()[0].axis();
-        return std::atan2(-a.x, a.y);
-    };
-    std::vector<double> crossings;
-    double th = tilt(), om = w.tumblers()[0].angularVelocity.z, t = 0.0;
-    const double tEnd = periods * 2.6;
-    while (w.time() < tEnd) {
-        w.step();
-        const double th1 = tilt(), om1 = w.tumblers()[0].angularVelocity.z;
-        if (th < 0.0 && th1 >= 0.0) crossings.push_back(hermiteRoot(t, dt, th, om, th1, om1));
-        th = th1, om = om1, t = w.time();
-    }
-    REQUIRE(crossings.size() >= 2);
-    return (crossings.back() - crossings.front()) / double(crossings.size() - 1);
+    const double period = reference::measuredPeriod(w, periods * 2.6);
+    REQUIRE(std::isfinite(period));  // at least two crossings
+    return period;
 }
 
 Planar planarOf(const World& w) {
