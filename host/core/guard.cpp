@@ -23,7 +23,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-constexpr int kFatalSignals[] = {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT};
 // Sent by the watchdog to the thread whose call overran; real-time, so it queues a
 // value (the call's id) and never collides with a signal someone else sends.
 int watchdogSignal() { return SIGRTMIN + 4; }

@@ -175,10 +175,6 @@ bool checkDynamicSection(std::ifstream& in, const Elf64_Ehdr& eh, uint64_t size,
     return true;
 }
 
-// Runs what dlopen runs — the library's static initialisers — and its entry point in a
-// child process, where a crash or a hang costs nothing: the host learns the signal and
-// never maps the library. Returns the fault, or nothing when the child came back (an
-// ordinary dlopen error is left for the host's own dlopen to report).
 // The addresses of a loaded library's executable segments (one, for a module).
 guard::CodeRange codeOf(void* handle) {
     struct link_map* map = nullptr;
@@ -206,11 +202,15 @@ guard::CodeRange codeOf(void* handle) {
 
 constexpr int kThrewStatus = 3;
 
+// Runs what dlopen runs — the library's static initialisers — and its entry point in a
+// child process, where a crash or a hang costs nothing: the host learns the signal and
+// never maps the library. Returns the fault, or nothing when the child came back (an
+// ordinary dlopen error is left for the host's own dlopen to report).
 std::optional<std::string> trialOpen(const fs::path& file) {
     const pid_t child = fork();
     if (child < 0) return std::nullopt;  // no process to spare: the guard is what is left
     if (child == 0) {
-        for (int sig : {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT}) signal(sig, SIG_DFL);
+        for (int sig : guard::kFatalSignals) signal(sig, SIG_DFL);
         const int devnull = open("/dev/null", O_WRONLY);  // its messages are the host's to give
         if (devnull >= 0) dup2(devnull, STDERR_FILENO), dup2(devnull, STDOUT_FILENO);
         // Nothing may unwind out of here: the child would go on as a copy of the host.
@@ -288,8 +288,11 @@ std::shared_ptr<LoadedModule> ModuleLoader::load(const std::string& name, std::s
         error = source.string() + ": cannot load: " + why;
         return nullptr;
     }
+    const auto cannotLoad = [&](const std::string& fault) {
+        return source.string() + ": cannot load: " + fault + " in its static initialisers or kiln_pass_module()";
+    };
     if (auto fault = trialOpen(copy)) {
-        error = source.string() + ": cannot load: " + *fault + " in its static initialisers or kiln_pass_module()";
+        error = cannotLoad(*fault);
         return nullptr;
     }
     // The child came through; the guard is for a library that behaves otherwise here.
@@ -308,8 +311,8 @@ std::shared_ptr<LoadedModule> ModuleLoader::load(const std::string& name, std::s
                 desc = entry();
             },
             guard::kUnwatched)) {
-        module->markFaulted(source.string() + ": " + *fault + " in its static initialisers or kiln_pass_module()");
-        error = source.string() + ": cannot load: " + *fault + " in its static initialisers or kiln_pass_module()";
+        error = cannotLoad(*fault);
+        module->markFaulted(error);
         return nullptr;
     }
     if (!opened) {
@@ -344,7 +347,7 @@ PassPtr ModuleLoader::create(const std::shared_ptr<LoadedModule>& module, std::s
     Pass* raw = nullptr;
     if (auto fault = guard::guarded([&] { raw = module->desc_->create(); }, module->watch())) {
         const std::string what = module->source_.filename().string() + ": " + *fault + " in create()";
-        if (fault->rfind("exception", 0) != 0) module->markFaulted(what);  // a throw unwound; a signal did not
+        if (!guard::unwound(*fault)) module->markFaulted(what);
         error = module->source_.string() + ": factory failed: " + *fault + " in create()";
         return nullptr;
     }

@@ -13,7 +13,7 @@ graph::Result<ModuleRegistry::Module> ModuleRegistry::probe(const std::string& n
     PassDeclaration decl;
     if (auto fault = guard::guarded([&] { decl = object->declare(); }, library->watch())) {
         const std::string what = library->sourcePath().filename().string() + ": " + *fault + " in declare()";
-        if (fault->rfind("exception", 0) != 0) library->markFaulted(what);  // a signal did not unwind
+        if (!guard::unwound(*fault)) library->markFaulted(what);
         return graph::Result<Module>::failure(library->sourcePath().string() + ": " + *fault + " in declare()");
     }
     object.reset();  // destroy() is tried here too: a module that faults in it is refused now
@@ -25,14 +25,6 @@ graph::Result<ModuleRegistry::Module> ModuleRegistry::probe(const std::string& n
 void ModuleRegistry::keepAsPrevious(const std::string& name, Module replaced) {
     if (replaced.library->faulted()) previous_.erase(name);
     else previous_[name] = std::move(replaced);
-}
-
-bool ModuleRegistry::rollBack(const std::string& name) {
-    auto it = previous_.find(name);
-    if (it == previous_.end()) return false;
-    modules_[name] = std::move(it->second);
-    previous_.erase(it);
-    return true;
 }
 
 const ModuleRegistry::Module* ModuleRegistry::previous(const std::string& name) const {

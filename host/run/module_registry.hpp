@@ -37,8 +37,6 @@ public:
     void erase(const std::string& name) { modules_.erase(name); }
     // After a reload: the build it replaced, kept to roll back to (unless it faulted).
     void keepAsPrevious(const std::string& name, Module replaced);
-    // Makes the kept build current again; false when there is none.
-    bool rollBack(const std::string& name);
     const Module* previous(const std::string& name) const;
     bool uses(const std::string& name) const { return modules_.count(name) > 0; }
     // Objects first, then libraries: a pass object's code lives in its library.

@@ -207,6 +207,15 @@ void Runtime::createPassObject(PassSlot& slot, const graph::PlannedPass& planned
     slot.invalidate(false);
 }
 
+// Every enabled pass of module `name` gets an object of the module now registered; the
+// old objects go first (their code lives in the old library), and the slots keep their
+// textures and parameters.
+void Runtime::recreatePassObjects(const std::string& name) {
+    for (size_t i = 0; i < slots_.size(); ++i)
+        if (slots_[i]->module == name && plan_->passes[i].state != graph::PassState::Disabled)
+            createPassObject(*slots_[i], plan_->passes[i]);
+}
+
 // The library's destroy() runs under the guard; a fault there is printed once, and
 // marks the library (no object is created from it again).
 void Runtime::destroyPassObject(PassSlot& slot) {
@@ -290,6 +299,7 @@ void Runtime::renderFrame(const SceneView& view, const SceneDraw& scene, const F
     collectGpuTimes();
     if (!plan_) return;
     const FrameResources shared{slots_, fallbacks_, *shaders_, scene, emptyVao_.id()};
+    glGetIntegerv(GL_DEBUG_GROUP_STACK_DEPTH, &frameGroupDepth_);  // a faulted pass's groups are popped to it
     for (size_t i = 0; i < slots_.size(); ++i) runPass(i, shared, view, frame);
     recoverFromFaults();
 }
@@ -315,13 +325,12 @@ void Runtime::runPass(size_t i, const FrameResources& shared, const SceneView& v
     std::optional<std::string> fault;
     {
         gl::DebugGroup group(slot.id);
-        GLint groupDepth = 0;
-        glGetIntegerv(GL_DEBUG_GROUP_STACK_DEPTH, &groupDepth);
         t.timer.begin();
         fault = guard::guarded([&] { slot.pass->execute(ctx); }, slot.library->watch());
         if (fault) {
             // What the pass left open is closed: its debug groups, its bindings.
-            for (GLint d = 0; glGetIntegerv(GL_DEBUG_GROUP_STACK_DEPTH, &d), d > groupDepth;) glPopDebugGroup();
+            // (The host's own group for the pass stays: `group` pops it.)
+            for (GLint d = 0; glGetIntegerv(GL_DEBUG_GROUP_STACK_DEPTH, &d), d > frameGroupDepth_ + 1;) glPopDebugGroup();
             resetGlState();
         }
         t.timer.end();
@@ -370,15 +379,13 @@ void Runtime::recoverFromFaults() {
         if (!current || !current->library->faulted()) continue;
         const ModuleRegistry::Module broken = *current;
         const std::string file = broken.library->sourcePath().filename().string();
-        std::string outcome = "; its passes are off until " + file + " changes";
+        std::string outcome = offUntilChanged(*broken.library);
         if (const ModuleRegistry::Module* previous = modules_->previous(name)) {
             modules_->set(name, *previous);
             std::string errors;
             if (desc_ && loadPipelineDesc(*desc_, errors)) {
                 modules_->keepAsPrevious(name, broken);  // faulted: forgets it
-                for (size_t i = 0; i < slots_.size(); ++i)
-                    if (slots_[i]->module == name && plan_->passes[i].state != graph::PassState::Disabled)
-                        createPassObject(*slots_[i], plan_->passes[i]);
+                recreatePassObjects(name);
                 outcome = "; rolled back to the build loaded before it, until " + file + " changes";
             } else {
                 modules_->set(name, broken);
@@ -388,6 +395,10 @@ void Runtime::recoverFromFaults() {
         setExternalError("module:" + name, message);
         if (broken.library->takeFaultToReport()) log::error(message);
     }
+}
+
+std::string Runtime::offUntilChanged(const LoadedModule& library) {
+    return "; its passes are off until " + library.sourcePath().filename().string() + " changes";
 }
 
 // A clean slate for every pass, so one pass's GL state never leaks into the next
@@ -473,8 +484,7 @@ std::vector<std::string> Runtime::activeErrors() const {
         // recoverFromFaults has usually put it among the external errors already.
         if (s->library && s->library->faulted()) {
             if (faultsNamed.insert(s->library.get()).second && !externalErrors_.count("module:" + s->module))
-                errors.push_back(s->library->fault() + "; its passes are off until " +
-                                 s->library->sourcePath().filename().string() + " changes");
+                errors.push_back(s->library->fault() + offUntilChanged(*s->library));
         } else if (!s->error.empty()) {
             errors.push_back(s->id + ": " + s->error);
         }
@@ -518,11 +528,7 @@ bool Runtime::reloadModule(const std::string& name, std::string& error) {
         return false;
     }
     if (old) modules_->keepAsPrevious(name, *old);
-    // Objects of the old library go first (their code lives there); their slots keep
-    // textures and parameters, and get an object of the new library.
-    for (size_t i = 0; i < slots_.size(); ++i)
-        if (slots_[i]->module == name && plan_->passes[i].state != graph::PassState::Disabled)
-            createPassObject(*slots_[i], plan_->passes[i]);
+    recreatePassObjects(name);
     return true;
 }
 

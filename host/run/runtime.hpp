@@ -122,6 +122,8 @@ private:
     void resetGlState() const;
     void retireFaultedObject(PassSlot&);
     void destroyPassObject(PassSlot&);
+    void recreatePassObjects(const std::string& module);
+    static std::string offUntilChanged(const LoadedModule&);
     void recoverFromFaults();
     void recompilePlan();
 
@@ -141,6 +143,7 @@ private:
     uint64_t versionCounter_ = 0;
     std::map<std::string, std::string> externalErrors_;
     std::set<std::string> faultedModules_;  // this frame's, recovered after it
+    GLint frameGroupDepth_ = 0;             // KHR_debug group depth when the passes start
 };
 
 }  // namespace kiln::run

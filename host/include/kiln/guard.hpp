@@ -24,6 +24,8 @@
 // default, or a sanitizer's handler): a bug in the host itself still crashes, loudly.
 #pragma once
 
+#include <signal.h>
+
 #include <chrono>
 #include <cstdint>
 #include <optional>
@@ -35,6 +37,13 @@ namespace kiln::guard {
 // The bound on one guarded call, for every thread; zero turns the watchdog off.
 void setWatchdogLimit(std::chrono::milliseconds limit);
 std::chrono::milliseconds watchdogLimit();
+
+// The signals the guard turns into errors.
+inline constexpr int kFatalSignals[] = {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT};
+
+// A fault that was an exception unwound the stack (destructors ran, locks released); a
+// signal or the watchdog did not, and leaves the faulting library's state suspect.
+inline bool unwound(const std::string& fault) { return fault.rfind("exception", 0) == 0; }
 
 // The name of a signal: "SIGSEGV", "SIGABRT", ...
 std::string signalName(int signal);
