@@ -16,11 +16,14 @@
 
 #include "kiln/guard.hpp"
 #include "kiln/module_loader.hpp"
+#include "support/faults.hpp"
 #include "run/module_registry.hpp"
 
 using namespace std::chrono_literals;
 using Catch::Contains;
 using kiln::ModuleLoader;
+using kiln::test::FaultSpec;
+using kiln::test::WatchdogLimit;
 
 namespace {
 
@@ -32,19 +35,6 @@ int recurse(int depth) {
     frame[depth % 512] = char(depth);
     return recurse(depth + 1) + frame[0];
 }
-
-// The watchdog's limit for one test, restored after it.
-struct WatchdogLimit {
-    std::chrono::milliseconds saved = kiln::guard::watchdogLimit();
-    explicit WatchdogLimit(std::chrono::milliseconds limit) { kiln::guard::setWatchdogLimit(limit); }
-    ~WatchdogLimit() { kiln::guard::setWatchdogLimit(saved); }
-};
-
-// KILN_TEST_FAULT for one load, removed after it.
-struct FaultSpec {
-    explicit FaultSpec(const std::string& spec) { setenv("KILN_TEST_FAULT", spec.c_str(), 1); }
-    ~FaultSpec() { unsetenv("KILN_TEST_FAULT"); }
-};
 
 }  // namespace
 

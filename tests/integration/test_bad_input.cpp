@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "support/faults.hpp"
 #include "support/run_kiln.hpp"
 
 namespace fs = std::filesystem;
@@ -188,9 +189,7 @@ TEST_CASE("bad module directories", "[integration][robust]") {
          "libpass_gbuffer.so: cannot load: truncated"},
         // What a linker leaves mid-write: the right size and headers, a body of zeros.
         {"modules-torn", [&](const fs::path& d) {
-             const std::string full = kiln::test::slurp(fs::path(real) / "libpass_gbuffer.so");
-             const size_t headers = 64 + 56 * 16;  // the ELF header and room for its program headers
-             write(d / "m/libpass_gbuffer.so", full.substr(0, headers) + std::string(full.size() - headers, '\0'));
+             write(d / "m/libpass_gbuffer.so", kiln::test::tornLibrary(kiln::test::slurp(fs::path(real) / "libpass_gbuffer.so")));
              return with(d); },
          "libpass_gbuffer.so: cannot load: its dynamic section lacks the symbol tables"},
         {"modules-symlink-loop", [&](const fs::path& d) {

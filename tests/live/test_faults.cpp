@@ -6,8 +6,8 @@
 // (its bug chosen by KILN_TEST_FAULT); `tint` after it runs whenever its output changes.
 #include <cstdlib>
 
-#include "kiln/guard.hpp"
 #include "live/sandbox.hpp"
+#include "support/faults.hpp"
 
 namespace fs = std::filesystem;
 using namespace kiln;
@@ -21,17 +21,6 @@ const fs::path kFixed = fs::path(FIXED_FAULTY_MODULE_DIR) / "libpass_test_faulty
 const std::string kPipeline = R"({"output": "tint.color",
     "passes": [{"id": "bad", "module": "test_faulty", "params": {"level": 0.25}},
                {"id": "tint", "module": "live_tint", "inputs": {"under": "bad.color"}, "params": {"level": 0.25}}]})";
-
-struct FaultSpec {
-    explicit FaultSpec(const std::string& spec) { setenv("KILN_TEST_FAULT", spec.c_str(), 1); }
-    ~FaultSpec() { unsetenv("KILN_TEST_FAULT"); }
-};
-
-struct WatchdogLimit {
-    std::chrono::milliseconds saved = guard::watchdogLimit();
-    explicit WatchdogLimit(std::chrono::milliseconds limit) { guard::setWatchdogLimit(limit); }
-    ~WatchdogLimit() { guard::setWatchdogLimit(saved); }
-};
 
 // Sandbox with `module` installed as libpass_test_faulty.so and the tint v1 build.
 Sandbox faultSandbox(const std::string& name, const fs::path& module) {

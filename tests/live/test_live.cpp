@@ -2,6 +2,7 @@
 // project's shaders, pipelines and scene. Waits poll frames with a generous timeout
 // and assert behaviour, never speed.
 #include "live/sandbox.hpp"
+#include "support/faults.hpp"
 
 namespace fs = std::filesystem;
 using namespace kiln;
@@ -117,8 +118,7 @@ TEST_CASE("a module written in two halves or torn is retried, not reported broke
 
     // Torn: the full size and the right headers, a body of zeros (what a linker leaves
     // mid-write). Waited for like a short file, never mapped; then the real bytes.
-    const size_t headers = 64 + 56 * 16;
-    writeInPlace(installed, full.substr(0, headers) + std::string(full.size() - headers, '\0'));
+    writeInPlace(installed, tornLibrary(full));
     REQUIRE(box.waitFor([&] { return box.app.live().pendingModules() == 1; }));
     CHECK(box.app.live().failures == failures);
     CHECK(near(box.centre(), {0.0f, 0.25f, 1.0f}));
