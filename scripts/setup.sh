@@ -14,6 +14,7 @@ packages=(
   xvfb xauth mesa-utils              # window tests/screenshots without a display
   inotify-tools                      # used by live-reload test scripts
   xdotool imagemagick                # driving the window in tests (keys, clicks, screenshots)
+  python3-matplotlib                 # the benchmark commands' figures (scripts/plot.py)
 )
 # scripts/fuzz.sh only: clang with libFuzzer (not needed to build, run or test).
 [ "${1:-}" = "--fuzz" ] && packages+=(clang-14 libclang-rt-14-dev)

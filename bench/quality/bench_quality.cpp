@@ -14,7 +14,7 @@
 //    reference pass's code (progress and ETA on stderr while it renders). The
 //    reference is their mean R = (A + B)/2, the same --spp paths as one render.
 // 3. The pipeline once as it is ("default"), each --also pipeline as it is (labelled by
-//    its file name, e.g. pipelines/seed.json: before and after in one run), and once
+//    its file name, e.g. pipelines/course.json: before and after in one run), and once
 //    per value of each --sweep (one
 //    knob at a time around the default, or every combination with --cartesian; without
 //    --sweep, the documented subset below).
@@ -63,7 +63,7 @@
 #include "kiln/image_io.hpp"
 #include "kiln/log.hpp"
 #include "metrics.hpp"
-#include "plot.hpp"
+#include <kiln/plot_script.hpp>
 #include "support/bench_support.hpp"
 
 namespace fs = std::filesystem;
@@ -72,7 +72,7 @@ using namespace kiln::bench;
 
 namespace {
 
-// The documented subset swept when no --sweep is given: the knobs the seed's report
+// The documented subset swept when no --sweep is given: the knobs the course design's report
 // discusses (voxel resolution, aperture, step schedule, trace stride) and the shadow
 // filter and map size, the indirect output's size, the lamp's model and its vertices
 // or points, the diffuse bounces. The mips and
@@ -572,31 +572,11 @@ int main(int argc, char** argv) {
             std::printf("%-44s %12.5f %14s\n", r.label.c_str(), r.ringRelMseCorrected, ratioCell(r.ringRatio).c_str());
     }
 
-    LogLogPlot plot{"GPU ms against error vs the reference", "total GPU ms per frame",
-                    "relative MSE, noise-corrected (less the reference's own; emitters masked)", {}};
-    PlotSeries all{"settings", {150, 150, 150}, {}, false, 3}, front{"Pareto front", {200, 40, 40}, {}, true, 4},
-        defaults{"default", {30, 90, 220}, {}, false, 7};
-    std::vector<const Result*> onFront;
-    std::vector<PlotSeries> others;  // one highlighted point per --also pipeline
-    std::string offThePlot;          // log axes: a corrected relMSE ≤ 0 has no place on them
-    const std::array<uint8_t, 3> otherColors[] = {{230, 140, 20}, {40, 160, 70}, {140, 60, 170}};
-    for (auto& r : results) {
-        all.points.emplace_back(r.totalMs, r.relMseCorrected);
-        if (r.relMseCorrected <= 0.0) offThePlot += (offThePlot.empty() ? "" : ", ") + r.label;
-        if (r.pareto) onFront.push_back(&r);
-        if (r.label == "default") defaults.points.emplace_back(r.totalMs, r.relMseCorrected);
-        for (size_t i = 0; i < args.also.size(); ++i)
-            if (r.label == fs::path(args.also[i]).stem().string())
-                others.push_back({r.label, otherColors[i % 3], {{r.totalMs, r.relMseCorrected}}, false, 7});
-    }
-    std::sort(onFront.begin(), onFront.end(), [](auto* a, auto* b) { return a->totalMs < b->totalMs; });
-    for (auto* r : onFront) front.points.emplace_back(r->totalMs, r->relMseCorrected);
-    plot.series = {all, front, defaults};
-    plot.series.insert(plot.series.end(), others.begin(), others.end());
+    csv.close();  // complete on disk before the plot script reads it
     const std::string pngPath = (fs::path(args.outDir) / "quality.png").string();
-    if (!writeLogLogPng(pngPath, plot, error)) return fail(error) ? 0 : 1;
-    if (!offThePlot.empty())
-        std::printf("\nnot on the plot (corrected relMSE <= 0: within the reference's noise): %s\n", offThePlot.c_str());
+    std::vector<std::string> plotArgs{"quality", csvPath, pngPath};
+    for (auto& also : args.also) plotArgs.insert(plotArgs.end(), {"--highlight", fs::path(also).stem().string()});
+    if (!kiln::drawPlot(plotArgs, error)) return fail(error) ? 0 : 1;
 
     // null where a figure has no value (nlohmann writes NaN as null).
     const nlohmann::json summary = {

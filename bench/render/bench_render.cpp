@@ -32,7 +32,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/app.hpp"
-#include "plot.hpp"
+#include <kiln/plot_script.hpp>
 #include "app/context.hpp"
 #include "kiln/log.hpp"
 #include "support/bench_support.hpp"
@@ -260,30 +260,22 @@ void reportGrowth(const Args& args, const std::vector<Config>& configs, std::vec
     std::printf("growth: frame cost against %s (ratio to the first count of the same pipeline)\n", args.growKind.c_str());
     std::printf("  %-10s %9s %10s %9s %7s %11s %10s %9s\n", "pipeline", args.growKind.c_str(), "particles", "frame ms",
                 "ratio", "voxelize ms", "gbuffer ms", "shadow ms");
-    LogLogPlot plot{"frame cost against " + args.growKind + " (" + std::to_string(args.width) + "x" +
-                        std::to_string(args.height) + ", moving)",
-                    args.growKind, "frame ms (wall, glFinish)", {}};
-    const std::array<uint8_t, 3> colors[] = {{30, 90, 200}, {200, 60, 40}, {40, 150, 60}, {120, 60, 160}};
     std::map<std::string, double> base;
     for (size_t i = 0; i < configs.size(); ++i) {
         const std::string pipeline = fs::path(configs[i].pipeline).stem().string();
         Measured& m = measured[i];
         const double frame = median(m.frameMs);
-        if (!base.count(pipeline)) {
-            base[pipeline] = frame;
-            plot.series.push_back({pipeline, colors[(plot.series.size()) % 4], {}, true, 3});
-        }
-        for (auto& s : plot.series)
-            if (s.label == pipeline) s.points.push_back({double(std::max(configs[i].grown, 1)), frame});
+        if (!base.count(pipeline)) base[pipeline] = frame;
         auto gpu = [&](const char* id) { return m.gpu.count(id) ? median(m.gpu[id]) : 0.0; };
         std::printf("  %-10s %9d %10.0f %9.2f %7.2f %11.2f %10.2f %9.2f\n", pipeline.c_str(), configs[i].grown,
                     median(m.particles), frame, frame / base[pipeline], gpu("voxelize"), gpu("gbuffer"), gpu("shadow"));
         csv << pipeline << "," << configs[i].grown << "," << median(m.particles) << "," << frame << ","
             << frame / base[pipeline] << "," << gpu("voxelize") << "," << gpu("gbuffer") << "," << gpu("shadow") << "\n";
     }
+    csv.close();  // complete on disk before the plot script reads it
     std::string error;
     const std::string png = (fs::path(args.outDir) / "growth.png").string();
-    if (writeLogLogPng(png, plot, error)) std::printf("wrote %s and %s\n", csvPath.c_str(), png.c_str());
+    if (kiln::drawPlot({"growth", csvPath, png}, error)) std::printf("wrote %s and %s\n", csvPath.c_str(), png.c_str());
     else std::fprintf(stderr, "kiln-bench-render: %s: %s\n", png.c_str(), error.c_str());
 }
 
