@@ -1,16 +1,16 @@
 // bloom — the bright part of the picture, blurred: a bright-pass of the
 // G-buffer's emitted radiance (`color`, bound to gbuffer.emissive), then a separable
-// Gaussian of σ = radius/2 full-resolution pixels (radius 4 = the seed's 9×9 kernel).
+// Gaussian of σ = radius/2 full-resolution pixels (radius 4 = the course design's 9×9 kernel).
 // It runs at HALF resolution: a compute bright-pass averages each 2×2 block into the
 // internal `bright` (the same light, a quarter of the pixels), and the blur uses
-// radius/2 taps per side with σ halved, so the glow has the seed's footprint on
+// radius/2 taps per side with σ halved, so the glow has the course design's footprint on
 // screen; composite's bilinear lookup upsamples it. Horizontal into the internal
 // `ping`, vertical into `bloom`. Composite adds it.
 //
 // Order: bloom runs BEFORE composite, so it cannot read composite's HDR image. What
 // blooms in this scene is what glows — the lamp, the fireballs, the particles, burning
 // marbles — and that is exactly the emitted radiance, so the bright-pass reads it (the
-// seed's "bright part of the G-buffer colour"); direct-lit surfaces stay around 1 and
+// course design's "bright part of the G-buffer colour"); direct-lit surfaces stay around 1 and
 // would not pass a threshold of 1 anyway. No lighting/composite split is needed.
 //
 // Nothing bright: the bright-pass also raises a flag in a 4-byte buffer (an atomicOr

@@ -11,7 +11,7 @@
 //   1   the normal.
 //   5   the normal + 4 at 45°; weights ∝ cos θ.
 //   6   the normal + 5 at 60° (azimuths 72° apart), weights π/4 and 3π/20 over π: the
-//       seed's set (also VCTRenderer's), with 60° cones.
+//       course design's set (also VCTRenderer's), with 60° cones.
 //   9   the normal + 4 at 30° + 4 at 60° (azimuths offset 45°); weights ∝ cos θ.
 //   16  the normal + 5 at 30° + 10 at 60°; weights ∝ cos θ.
 // The aperture is a parameter of its own (60° suits 6 cones; more cones, narrower).

@@ -1,4 +1,4 @@
-// voxel_view — the seed's voxel figure: ray-marches the voxel radiance at a
+// voxel_view — the course design's voxel figure: ray-marches the voxel radiance at a
 // chosen mip level from the camera, front to back, drawing each voxel as a box (nearest
 // lookups, one step per voxel boundary crossed: an exact 3D DDA). Bind `voxels` to
 // voxel_mip.iso (any level) or voxelize.radiance (level 0 only).

@@ -74,7 +74,7 @@ public:
             d.internal({.name = sum, .kind = TextureKind::Color3D, .format = Format::R32UI, .size = cube});
         d.param(intChoiceParam("resolution", 64, {32, 64, 128}, "voxels per side over [-1,1]^3"))
             .param(boolParam("conservative", true, "enlarge triangles by half a voxel (no holes from thin triangles)"))
-            .param(boolParam("marbles", false, "voxelize the marbles too (the seed leaves them out)"))
+            .param(boolParam("marbles", false, "voxelize the marbles too (the course design leaves them out)"))
             .param(boolParam("particles", true, "voxelize the emissive particles"))
             .param(enumParam("particle_mode", "splat", {"splat", "mesh"},
                              "splat: a compute pass adds each particle to the voxels it overlaps; mesh: rasterize "

@@ -56,7 +56,7 @@ vec4 lightSpace(vec3 world) {
 // KILN_LAMP_CONTOUR 0: the area form ∫_cap L cos θ_p cos θ_q / d² dA by a fixed
 //   KILN_LAMP_SAMPLES-point quadrature, equal-area points on the cap (Archimedes) on
 //   a golden-angle spiral. Near the dome the integrand is near-singular: bright lobes
-//   and dark bands on the ceiling around it (the seed's lamp; kept to compare).
+//   and dark bands on the ceiling around it (the course design's lamp; kept to compare).
 #ifndef KILN_LAMP_SAMPLES
 #define KILN_LAMP_SAMPLES 32
 #endif

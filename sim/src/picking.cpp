@@ -26,7 +26,7 @@ std::optional<RayHit> World::raycastTumblers(const Vec3& origin, const Vec3& dir
 DragMode World::beginDrag(const RayHit& hit) {
     drag_.tumbler = hit.tumbler;
     Tumbler& t = tumblers_[size_t(hit.tumbler)];
-    // docs/physics.md §4: a hit below the centre of mass translates, above rotates (the seed's
+    // docs/physics.md §4: a hit below the centre of mass translates, above rotates (the course design's
     // centre of mass is O at y = −1 + b; accurate mode's sits ballast_h lower).
     drag_.mode = hit.point.y < centreOfMass(hit.tumbler).y ? DragMode::Translate : DragMode::Rotate;
     drag_.planeY = hit.point.y;

@@ -7,7 +7,7 @@ using namespace detail;
 
 namespace {
 
-// The seed's four-sphere test: each end sphere of one tumbler against the other's exact
+// The course design's four-sphere test: each end sphere of one tumbler against the other's exact
 // SDF; the contact point and normal (A → B) are averaged over the spheres that touch.
 // Returns the smallest sphere separation (negative: overlap).
 double fourSphereContact(const World& w, int a, int b, const RoundCone& shape, Vec3& n, Vec3& h) {
@@ -121,7 +121,7 @@ double World::resolveTumblerPair(int a, int b) {
         n = sep.normal;
         h = 0.5 * (sep.witnessA + sep.witnessB);
     } else {
-        // The seed's approximation: each end sphere against the other's exact SDF.
+        // The course design's approximation: each end sphere against the other's exact SDF.
         separation = fourSphereContact(*this, a, b, shape_, n, h);
         if (separation >= 0.0) return separation;
     }

@@ -10,7 +10,7 @@
 // (ṙ = ω × s, not ω × r: P slides along the lower sphere). Integrated with classical
 // RK4 on (O, q, ω), q renormalised after each step.
 //
-// Seed mode keeps the seed's model: centre of mass at O, the restoring impulse −Δt·d at
+// Course mode keeps the course design's model: centre of mass at O, the restoring impulse −Δt·d at
 // one unit above O, and rolling imposed as a velocity impulse each sub-step
 // (semi-implicit Euler). Both modes then apply docs/physics.md §3's friction and sleep.
 #include "internal.hpp"
@@ -69,7 +69,7 @@ RollState rk4(const RollBody& body, const RollState& s, double dt) {
 void World::stepTumbler(int i, double dt) {
     Tumbler& t = tumblers_[size_t(i)];
     if (t.asleep || drag_.tumbler == i) return;
-    if (scene_.physics.tumblerMode == TumblerMode::Seed) stepTumblerSeed(i, dt);
+    if (scene_.physics.tumblerMode == TumblerMode::Course) stepTumblerCourse(i, dt);
     else stepTumblerRolling(i, dt);
     applyFriction(t, dt);
     t.velocity = shape_.b() * Vec3(-t.angularVelocity.z, 0.0, t.angularVelocity.x);
@@ -115,7 +115,7 @@ void World::stepTumblerRolling(int i, double dt) {
     t.angularVelocity = start.w;
 }
 
-void World::stepTumblerSeed(int i, double dt) {
+void World::stepTumblerCourse(int i, double dt) {
     Tumbler& t = tumblers_[size_t(i)];
     const double m = tumblerMass(), b = shape_.b();
     Vec3 g = t.position + t.rotation() * comLocal_;
@@ -123,7 +123,7 @@ void World::stepTumblerSeed(int i, double dt) {
     Vec3& w = t.angularVelocity;
     const Mat3 invI = inverseInertiaWorld(i);
     vG.y -= scene_.physics.gravity * dt;
-    // The seed's restoring impulse −Δt·d at one unit above O.
+    // The course design's restoring impulse −Δt·d at one unit above O.
     const Vec3 j = -dt * t.axis(), at = t.position + Vec3(0, 1, 0);
     vG += j / m;
     w += invI * glm::cross(at - g, j);

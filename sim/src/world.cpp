@@ -19,7 +19,7 @@ void World::reset(const Scene& scene) {
         comLocal_ = Vec3(0, -scene.physics.ballastH, 0);
         inertiaCom_ = mass_.inertiaCom;
     } else {
-        // The seed's assumption: centre of mass at O.
+        // The course design's assumption: centre of mass at O.
         comLocal_ = Vec3(0.0);
         inertiaCom_ = mass_.inertiaOrigin;
     }

@@ -1,7 +1,7 @@
 // kiln-sim bench: cost vs body count; the tumbler's rocking period and 3D invariants vs
 // Δt and sub-steps against independent references (the period by quadrature, energy and
 // Jellett's quantity that the exact flow conserves), with time per simulated second;
-// marbles against the closed-form free fall; the seed's four-sphere tumbler contact vs
+// marbles against the closed-form free fall; the course design's four-sphere tumbler contact vs
 // the exact one. Tables on stdout, CSV + PNG plots in the output folder.
 #include "bench.hpp"
 
@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "kiln/sim/world.hpp"
-#include "plot.hpp"
+#include <kiln/plot_script.hpp>
 #include "reference.hpp"
 
 using namespace kiln::sim;
@@ -314,25 +314,10 @@ bool benchContactScene(const Scene& scene, const Out& out, bool quick) {
 
 // ---- 5. figures -------------------------------------------------------------------------
 
-bool writePlots(const std::vector<RockingRow>& rows, const Out& out) {
-    const std::array<uint8_t, 3> blue{30, 90, 200}, red{210, 50, 40}, green{40, 150, 60}, orange{230, 140, 20};
-    LogLogPlot cost{"tumbler: time vs error (exact rolling, RK4)", "microseconds per simulated second", "relative error", {}};
-    LogLogPlot dt{"tumbler: error vs sub-step", "sub-step dt (s)", "relative error", {}};
-    for (int sub : {1, 4}) {
-        PlotSeries p{"period 10deg, " + std::to_string(sub) + " sub", sub == 1 ? blue : green, {}};
-        PlotSeries e{"energy drift, " + std::to_string(sub) + " sub", sub == 1 ? red : orange, {}};
-        PlotSeries pd = p, ed = e;
-        for (const RockingRow& r : rows) {
-            if (r.sub != sub) continue;
-            p.points.push_back({r.usPerSimSecond, r.err10}), e.points.push_back({r.usPerSimSecond, r.energy});
-            pd.points.push_back({r.dt / sub, r.err10}), ed.points.push_back({r.dt / sub, r.energy});
-        }
-        cost.series.push_back(p), cost.series.push_back(e);
-        dt.series.push_back(pd), dt.series.push_back(ed);
-    }
+// matplotlib draws them from sim_rocking.csv (scripts/plot.py).
+bool writePlots(const Out& out) {
     std::string error;
-    if (!writeLogLogPng((fs::path(out.dir) / "sim_time_vs_error.png").string(), cost, error) ||
-        !writeLogLogPng((fs::path(out.dir) / "sim_error_vs_dt.png").string(), dt, error)) {
+    if (!kiln::drawPlot({"sim", (fs::path(out.dir) / "sim_rocking.csv").string(), out.dir}, error)) {
         std::fprintf(stderr, "kiln-sim: error: %s\n", error.c_str());
         return false;
     }
@@ -354,7 +339,7 @@ int runBenchmarks(const Scene& scene, const std::string& outDir, bool quick) {
     if (!benchCost(scene, out, quick ? 0.05 : 0.5)) return 1;
     const std::vector<RockingRow> rows = benchRocking(rocking, out, quick);
     if (rows.empty() || !benchMarble(out, quick) || !benchContactPoses(scene, out, quick) ||
-        !benchContactScene(scene, out, quick) || !writePlots(rows, out))
+        !benchContactScene(scene, out, quick) || !writePlots(out))
         return 1;
     std::printf("\nwrote %s/: sim_steps.csv, sim_rocking.csv, sim_marble.csv, sim_contact.csv, sim_contact_scene.csv,\n"
                 "  sim_time_vs_error.png, sim_error_vs_dt.png\n",

@@ -19,7 +19,7 @@ namespace {
 const char* kUsage = R"(kiln-sim - Kiln's physics without OpenGL
 
 usage:
-  kiln-sim run   [--scene FILE] [--steps N] [--seed S] [--mode seed|accurate]
+  kiln-sim run   [--scene FILE] [--steps N] [--seed S] [--mode course|accurate]
                  [--contact four_spheres|exact]
       loads the scene, steps the world N frames (default 1000) and prints the state
       hash and the invariants (finite state, |q| - 1, containment); exits 1 if an
@@ -69,7 +69,7 @@ int runScene(const Scene& scene, const std::string& scenePath, long long steps) 
     int asleep = 0;
     for (auto& t : world.tumblers()) asleep += t.asleep;
     std::printf("scene %s  seed %llu  mode %s  contact %s\n", scenePath.c_str(), (unsigned long long)scene.physics.seed,
-                scene.physics.tumblerMode == TumblerMode::Seed ? "seed" : "accurate",
+                scene.physics.tumblerMode == TumblerMode::Course ? "course" : "accurate",
                 scene.physics.tumblerContact == TumblerContact::Exact ? "exact" : "four_spheres");
     std::printf("steps %lld  t %.4f s  hash %016llx  (%.0f steps/s)\n", steps, world.time(),
                 (unsigned long long)world.stateHash(), seconds > 0 ? double(steps) / seconds : 0.0);
@@ -123,8 +123,8 @@ int main(int argc, char** argv) {
     Scene scene = loaded.scene;
     if (seed >= 0) scene.physics.seed = uint64_t(seed);
     if (!mode.empty()) {
-        if (mode != "seed" && mode != "accurate") return fail("--mode " + mode + ": expected seed or accurate");
-        scene.physics.tumblerMode = mode == "seed" ? TumblerMode::Seed : TumblerMode::Accurate;
+        if (mode != "course" && mode != "accurate") return fail("--mode " + mode + ": expected course or accurate");
+        scene.physics.tumblerMode = mode == "course" ? TumblerMode::Course : TumblerMode::Accurate;
     }
     if (!contact.empty()) {
         if (contact != "exact" && contact != "four_spheres")

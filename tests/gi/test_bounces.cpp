@@ -72,7 +72,7 @@ TEST_CASE("voxel_mip bounces: the white furnace — k bounces show 2 − 0.5^k o
     // set that loses a twentieth of the light. Both directional modes of the chains
     // the bounces are gathered through (aniso: 1.507 / 1.753 / 1.876 / 1.937). Not iso:
     // its averaged coarse levels let cones through the one-voxel walls, so a furnace
-    // frame shows 1.21 at k = 1 and 1.27 at k = 4 — the seed's self-occlusion finding,
+    // frame shows 1.21 at k = 1 and 1.27 at k = 4 — the course design's self-occlusion finding,
     // seen as lost energy.
     const std::string mode = GENERATE(std::string("fixed_cones"), std::string("aniso"));
     Rig rig(writeScene("furnace_bounces.json", kFurnaceBox), 48);

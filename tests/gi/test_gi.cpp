@@ -689,13 +689,13 @@ std::string seedPipeline(const std::string& mode, int res) {
 }
 }  // namespace
 
-TEST_CASE("cone_trace: the ceiling is brighter with anisotropic mips than with isotropic ones (the seed's observation)",
+TEST_CASE("cone_trace: the ceiling is brighter with anisotropic mips than with isotropic ones (the course design's observation)",
           "[gi][cone]") {
     // The ceiling gets no direct light (the lamp is above it), so what it shows is the
     // indirect term. Isotropic mips average each wall voxel with the empty space in
     // front of it (opacity 1/2 at level 1, 1/4 at level 2, ...), so the lit floor and
     // walls a cone meets look dimmer and half-transparent; the directional chains see
-    // them opaque and at full radiance. Margin: aniso ≥ 1.1 × iso (the seed reports a
+    // them opaque and at full radiance. Margin: aniso ≥ 1.1 × iso (the course report shows a
     // visibly darker ceiling; we measure ~1.3–1.5× here).
     double ceiling[2] = {};
     for (int m = 0; m < 2; ++m) {

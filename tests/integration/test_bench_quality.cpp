@@ -58,15 +58,15 @@ TEST_CASE("kiln-bench-quality: a tiny sweep writes one finite CSV row per settin
     const std::string out = std::string(TEST_OUTPUT_DIR) + "/bench-quality";
     std::filesystem::remove_all(out);
     const std::string args = "--size 32x32 --spp 8 --frames 1 --repeats 2 --time 0.1 --sweep composite.pcf=1,9 "
-                             "--also pipelines/seed.json --out " + out;
+                             "--also pipelines/course.json --out " + out;
     Run first = runProgram(KILN_BENCH_QUALITY, args, 300);
     INFO(first.out << first.err);
     REQUIRE(first.exitCode == 0);
     const QualityCsv csv(slurp(out + "/quality.csv"));
-    int rows = 0, front = 0, seedRows = 0;
+    int rows = 0, front = 0, courseRows = 0;
     for (size_t i = 0; i < csv.rows.size(); ++i) {
         ++rows;
-        seedRows += csv.text(i, "setting") == "seed";
+        courseRows += csv.text(i, "setting") == "course";
         for (const char* name : {"total_gpu_ms", "rmse", "rel_mse", "psnr", "pixels", "rel_mse_indirect", "rel_mse_floor",
                                  "rel_mse_walls", "rel_mse_ceiling", "rel_mse_objects", "rel_mse_corrected",
                                  "rel_mse_indirect_corrected", "mean_ratio_all", "mean_ratio_all_uncertainty",
@@ -92,8 +92,8 @@ TEST_CASE("kiln-bench-quality: a tiny sweep writes one finite CSV row per settin
     }
     const std::string summary = slurp(out + "/summary.json");
     CHECK(summary.find("\"ref_noise_rel_mse\"") != std::string::npos);
-    CHECK(rows == 4);  // default, seed (--also), 2 sweep values
-    CHECK(seedRows == 1);
+    CHECK(rows == 4);  // default, course (--also), 2 sweep values
+    CHECK(courseRows == 1);
     CHECK(front >= 1);
     Run second = runProgram(KILN_BENCH_QUALITY, args, 300);
     CHECK(second.exitCode == 0);
@@ -173,19 +173,19 @@ TEST_CASE("kiln-bench-render --grow: one growth row per count, the first the bas
     CHECK(failing.out.find("frame (wall, glFinish)") == std::string::npos);
 }
 
-TEST_CASE("the default pipeline is closer to the path-traced reference than the seed's design (seed.json)",
+TEST_CASE("the default pipeline is closer to the path-traced reference than the course report's design (course.json)",
           "[integration][bench][quality]") {
     // The claim behind the default's settings, checked against the independent path
     // tracer rather than against a finer run of the rasterizer: 96² at t = 0.5 s, a
     // 256-path reference in two seeded halves (~3 min here; deterministic figures).
     // Measured (noise-corrected relMSE): 0.0518 against 0.0717, the indirect part 0.0864
     // against 0.120; the mean luminance 1.000× the reference's against 0.799× (issue
-    // 22: the seed's one bounce misses a fifth of the light; ±0.002 from the
+    // 22: the course design's one bounce misses a fifth of the light; ±0.002 from the
     // reference's noise). SSIM is withheld at this path count (the halves disagree).
-    const std::string out = std::string(TEST_OUTPUT_DIR) + "/bench-quality-default-vs-seed";
+    const std::string out = std::string(TEST_OUTPUT_DIR) + "/bench-quality-default-vs-course";
     Run r = runProgram(KILN_BENCH_QUALITY,
                        "--size 96x96 --spp 256 --frames 1 --repeats 1 --sweep composite.exposure=1 "
-                       "--also pipelines/seed.json --out " + out,
+                       "--also pipelines/course.json --out " + out,
                        600);
     INFO(r.out << r.err);
     REQUIRE(r.exitCode == 0);
@@ -193,18 +193,18 @@ TEST_CASE("the default pipeline is closer to the path-traced reference than the 
     double relMse[2] = {-1, -1}, indirect[2] = {-1, -1}, light[2] = {-1, -1};
     for (size_t i = 0; i < csv.rows.size(); ++i) {
         const std::string& label = csv.text(i, "setting");
-        const int which = label == "default" ? 0 : label == "seed" ? 1 : -1;
+        const int which = label == "default" ? 0 : label == "course" ? 1 : -1;
         if (which < 0) continue;
         relMse[which] = csv.number(i, "rel_mse_corrected");
         indirect[which] = csv.number(i, "rel_mse_indirect_corrected");
         light[which] = csv.number(i, "mean_ratio_all");
     }
-    INFO("relMSE default " << relMse[0] << " seed " << relMse[1] << "; indirect " << indirect[0] << " / " << indirect[1]);
+    INFO("relMSE default " << relMse[0] << " course " << relMse[1] << "; indirect " << indirect[0] << " / " << indirect[1]);
     REQUIRE(relMse[0] > 0);
     REQUIRE(relMse[1] > 0);
     CHECK(relMse[0] < relMse[1]);
     CHECK(indirect[0] < indirect[1]);
-    INFO("mean luminance ÷ the reference's: default " << light[0] << ", seed " << light[1]);
+    INFO("mean luminance ÷ the reference's: default " << light[0] << ", course " << light[1]);
     CHECK(std::abs(light[0] - 1.0) < 0.03);
     CHECK(light[1] < 0.9);
 }

@@ -164,7 +164,7 @@ TEST_CASE("textures beyond the budget or the GL limits are a named error and the
     ro.shaderRoots = {o.shaderRoot};
     ro.moduleDirs = {o.moduleDir};
     ro.width = ro.height = 64;
-    // The seed pipeline at 64² needs ≈ 28 MiB (a 2048² depth map is 16 MiB, the 64³
+    // The course pipeline at 64² needs ≈ 28 MiB (a 2048² depth map is 16 MiB, the 64³
     // volumes with mips ≈ 11 MiB); a 48 MiB budget holds it, but not its variant with a
     // 4096² shadow map (+ 48 MiB) nor the same plan at 4096² (a 4096² RGBA16F is 128 MiB).
     ro.textureBudgetBytes = 48ull << 20;
@@ -172,7 +172,7 @@ TEST_CASE("textures beyond the budget or the GL limits are a named error and the
     std::string error;
     REQUIRE(rt.init(ro, error));
     INFO(error);
-    REQUIRE(rt.loadPipeline(std::string(KILN_SOURCE_DIR) + "/pipelines/seed.json", error));
+    REQUIRE(rt.loadPipeline(std::string(KILN_SOURCE_DIR) + "/pipelines/course.json", error));
     const graph::Plan* before = rt.plan();
     const std::string text = rt.pipelineText();
     std::string big = text;

@@ -1,4 +1,4 @@
-// Tumbler against tumbler (exact round-cone separation vs brute force, the seed's
+// Tumbler against tumbler (exact round-cone separation vs brute force, the course design's
 // four-sphere approximation), the impulse solver on singular K, world-space SDFs.
 #include <catch2/catch.hpp>
 

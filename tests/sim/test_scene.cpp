@@ -62,7 +62,7 @@ TEST_CASE("bad scene files give the JSON path and what is wrong", "[sim][scene]"
     CHECK(errorOf(R"({"tumblers": [], "physics": {"dt": 5}})") ==
           "scenes/x.json: physics.dt: must be within [0.000010, 0.100000], got 5");
     CHECK(errorOf(R"({"tumblers": [], "physics": {"tumbler_mode": "fast"}})") ==
-          "scenes/x.json: physics.tumbler_mode: expected one of \"seed\", \"accurate\", got \"fast\"");
+          "scenes/x.json: physics.tumbler_mode: expected one of \"course\", \"accurate\", got \"fast\"");
     CHECK(errorOf(R"({"tumblers": [], "marbles": [{"position": [0, 0.99, 0]}]})") ==
           "scenes/x.json: marbles[0].position: the ball (radius 0.05) does not fit inside the box [-1,1]^3");
     CHECK(errorOf(R"({"tumblers": [], "lamp": {"radius": 0.3, "colour": [1,1,1]}})") == "scenes/x.json: lamp.colour: unknown key");

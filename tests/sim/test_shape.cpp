@@ -134,10 +134,10 @@ TEST_CASE("SDF and gradient stay finite on the axis and at the sphere centres", 
     CHECK(s.radiusAt(s.top() + 0.01) == 0.0);
 }
 
-TEST_CASE("the seed's threshold slip is fixed: 1 cm above the top reads +1 cm", "[sim][shape]") {
+TEST_CASE("the course design's threshold slip is fixed: 1 cm above the top reads +1 cm", "[sim][shape]") {
     RoundCone s;
     CHECK(s.upperCentre() == Approx(0.292380440016).epsilon(1e-11));
-    // With the seed's y_t/tan α threshold this read −0.062 (docs/physics.md §1).
+    // With the course design's y_t/tan α threshold this read −0.062 (docs/physics.md §1).
     CHECK(s.sdf(Vec3(0, s.top() + 0.01, 0)) == Approx(0.01).margin(1e-12));
     CHECK(s.sdf(Vec3(0, s.top() - 0.01, 0)) == Approx(-0.01).margin(1e-12));
 }

@@ -341,9 +341,9 @@ TEST_CASE("accurate mode: the period at 30 degrees matches the exact quadrature"
     CHECK(std::abs(period - 2.00225) / 2.00225 < 0.01);
 }
 
-TEST_CASE("seed mode: the restoring impulse rights a tilted tumbler", "[sim][world]") {
+TEST_CASE("course mode: the restoring impulse rights a tilted tumbler", "[sim][world]") {
     Scene s = emptyScene();
-    s.physics.tumblerMode = TumblerMode::Seed;
+    s.physics.tumblerMode = TumblerMode::Course;
     s.physics.friction = 0.05;
     s.tumblers.push_back({{0.0, 0.0}, {0.3, 0.0}, {1, 0, 0}});
     World w(s);

@@ -24,7 +24,7 @@
 //       "gravity": 9.81,            // m/s², [0, 100]
 //       "friction": 0.005,          // μ of the rocking damping (docs/physics.md §3), [0, 10]
 //       "wall_decay": 0.5,          // tumbler velocity kept after hitting a wall, [0, 1]
-//       "tumbler_mode": "seed" | "accurate",         // restoring impulse | weighted base
+//       "tumbler_mode": "course" | "accurate",         // restoring impulse | weighted base
 //       "tumbler_contact": "four_spheres" | "exact", // tumbler-vs-tumbler method
 //       "ballast_h": 0.05,          // accurate mode: centre of mass this far below O
 //       "seed": 1,                  // random generator seed (integer ≥ 0)
@@ -85,7 +85,7 @@ struct SceneError {
     std::string toString(const std::string& file) const;
 };
 
-enum class TumblerMode : uint8_t { Seed, Accurate };
+enum class TumblerMode : uint8_t { Course, Accurate };
 enum class TumblerContact : uint8_t { FourSpheres, Exact };
 
 struct Scene {

@@ -81,7 +81,7 @@ struct ConeSeparation {
 ConeSeparation roundConeSeparation(const Vec3& a0, const Vec3& a1, double ra0, double ra1, const Vec3& b0,
                                    const Vec3& b1, double rb0, double rb1);
 
-// The seed's approximation (four end spheres, each against the other body's exact
+// The course design's approximation (four end spheres, each against the other body's exact
 // SDF): min of SDF_B(a0) − ra0, SDF_B(a1) − ra1, SDF_A(b0) − rb0, SDF_A(b1) − rb1.
 // Never below the exact separation (each end sphere is a subset of its body).
 double fourSphereSeparation(const Vec3& a0, const Vec3& a1, double ra0, double ra1, const Vec3& b0,

@@ -12,7 +12,7 @@
 //   own instance records from them); likewise particlesVersion() for particles().
 //
 // Model (docs/physics.md): a tumbler's lower-sphere centre O stays at y = −1 + b and it rolls
-// without slipping; "seed" mode puts the centre of mass at O and adds the seed's
+// without slipping; "course" mode puts the centre of mass at O and adds the course design's
 // restoring impulse, "accurate" mode puts it ballast_h below O so gravity rights it.
 // Balls (marbles with gravity, fireballs without) reflect without loss off the box,
 // the lamp dome, tumblers (momentum-conserving impulse) and each other (elastic).
@@ -183,7 +183,7 @@ public:
     // (negative: overlap) or +inf when they are too far apart to test.
     double resolveTumblerPair(int a, int b);
     // Applies impulse j at world point p to tumbler i as a free body (no floor; the
-    // seed's model). Contacts use applyRollingImpulse.
+    // course design's model). Contacts use applyRollingImpulse.
     void applyImpulse(int i, const Vec3& p, const Vec3& j);
     // Applies impulse j at world point p to tumbler i while it rolls on the floor: the
     // floor answers with whatever impulse at the contact point keeps it rolling without
@@ -234,7 +234,7 @@ public:
 private:
     void substep(double dt);
     void stepTumbler(int i, double dt);
-    void stepTumblerSeed(int i, double dt);
+    void stepTumblerCourse(int i, double dt);
     void stepTumblerRolling(int i, double dt);
     void applyFriction(Tumbler& t, double dt) const;
     void updateSleep(Tumbler& t, double dt);
