@@ -62,7 +62,24 @@ void deleteVertexArray(GLuint id) { glDeleteVertexArrays(1, &id); }
 void deleteProgram(GLuint id) { glDeleteProgram(id); }
 void deleteShader(GLuint id) { glDeleteShader(id); }
 void deleteQuery(GLuint id) { glDeleteQueries(1, &id); }
+void deleteSampler(GLuint id) { glDeleteSamplers(1, &id); }
 }  // namespace detail
+
+FramebufferHandle createFramebuffer() {
+    GLuint id = 0;
+    glCreateFramebuffers(1, &id);
+    return FramebufferHandle(id);
+}
+VertexArrayHandle createVertexArray() {
+    GLuint id = 0;
+    glCreateVertexArrays(1, &id);
+    return VertexArrayHandle(id);
+}
+SamplerHandle createSampler() {
+    GLuint id = 0;
+    glCreateSamplers(1, &id);
+    return SamplerHandle(id);
+}
 
 int Texture::fullMipCount(int w, int h, int d) {
     int m = std::max({w, h, d, 1});

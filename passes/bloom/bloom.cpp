@@ -28,10 +28,6 @@ namespace {
 
 class Bloom final : public kiln::Pass {
 public:
-    ~Bloom() override {
-        if (anyBright_) glDeleteBuffers(1, &anyBright_);
-    }
-
     kiln::PassDeclaration declare() const override {
         using namespace kiln;
         PassDeclaration d;
@@ -57,17 +53,14 @@ public:
         const float threshold = ctx.getFloat("threshold");
 
         // 1. Bright-pass + downsample, and the "anything bright" flag for the blur's early out.
-        if (!anyBright_) {
-            glCreateBuffers(1, &anyBright_);
-            glNamedBufferStorage(anyBright_, 4, nullptr, GL_DYNAMIC_STORAGE_BIT);
-        }
+        if (!anyBright_) anyBright_ = kiln::gl::Buffer::create(4, nullptr, GL_DYNAMIC_STORAGE_BIT, "bloom.any_bright");
         const GLuint zero = 0;
-        glNamedBufferSubData(anyBright_, 0, 4, &zero);
+        glNamedBufferSubData(anyBright_.id(), 0, 4, &zero);
         glUseProgram(brightPass);
         glUniform1f(glGetUniformLocation(brightPass, "u_threshold"), threshold);
         glBindTextureUnit(0, in.id);
         glBindImageTexture(0, bright.id, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA16F);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, anyBright_);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, anyBright_.id());
         glDispatchCompute(GLuint((bright.width + 7) / 8), GLuint((bright.height + 7) / 8), 1);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
 
@@ -88,7 +81,7 @@ public:
     }
 
 private:
-    GLuint anyBright_ = 0;  // 4 bytes: nonzero when a texel passed the threshold, GPU only
+    kiln::gl::Buffer anyBright_;  // 4 bytes: nonzero when a texel passed the threshold, GPU only
 };
 
 }  // namespace

@@ -77,15 +77,15 @@ public:
         // lookup a bilinear blend of four depth tests. A sampler object, so the shadow
         // pass's texture keeps its own state for the passes that read raw depth.
         if (!compareSampler_) {
-            glCreateSamplers(1, &compareSampler_);
-            glSamplerParameteri(compareSampler_, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-            glSamplerParameteri(compareSampler_, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-            glSamplerParameteri(compareSampler_, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-            glSamplerParameteri(compareSampler_, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-            glSamplerParameteri(compareSampler_, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
-            glSamplerParameteri(compareSampler_, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+            compareSampler_ = kiln::gl::createSampler();
+            glSamplerParameteri(compareSampler_.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+            glSamplerParameteri(compareSampler_.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+            glSamplerParameteri(compareSampler_.id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+            glSamplerParameteri(compareSampler_.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+            glSamplerParameteri(compareSampler_.id(), GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+            glSamplerParameteri(compareSampler_.id(), GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
         }
-        glBindSampler(4, compareSampler_);
+        glBindSampler(4, compareSampler_.id());
         draw(ctx, program);
         // The near field again, per pixel, over its screen rectangle only.
         if (nearField) {
@@ -99,10 +99,6 @@ public:
             }
         }
         glBindSampler(4, 0);
-    }
-
-    ~Composite() override {
-        if (compareSampler_) glDeleteSamplers(1, &compareSampler_);
     }
 
 private:
@@ -140,7 +136,7 @@ private:
         return {x0, y0, std::max(0, x1 - x0), std::max(0, y1 - y0)};
     }
 
-    GLuint compareSampler_ = 0;
+    kiln::gl::SamplerHandle compareSampler_;
 };
 
 }  // namespace

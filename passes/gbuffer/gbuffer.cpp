@@ -25,10 +25,6 @@ public:
         return d;
     }
 
-    ~GBuffer() override {
-        if (pointsVao_) glDeleteVertexArrays(1, &pointsVao_);
-    }
-
     void execute(kiln::PassContext& ctx) override {
         GLuint program = ctx.program({.stages = {"gbuffer/gbuffer.vert", "gbuffer/gbuffer.frag"}});
         const bool particles = ctx.getBool("particles");
@@ -67,11 +63,11 @@ public:
         // (4 000 octahedra cost the G-buffer 15 ms at 720² on llvmpipe).
         const uint32_t count = ctx.scene().count(kiln::kSceneParticles);
         if (points && count > 0) {
-            if (!pointsVao_) glCreateVertexArrays(1, &pointsVao_);
+            if (!pointsVao_) pointsVao_ = kiln::gl::createVertexArray();
             glUseProgram(pointProgram);
             glUniform1ui(glGetUniformLocation(pointProgram, "u_first"), ctx.scene().firstInstance(kiln::kSceneParticles));
             glEnable(GL_PROGRAM_POINT_SIZE);
-            glBindVertexArray(pointsVao_);
+            glBindVertexArray(pointsVao_.id());
             glDrawArrays(GL_POINTS, 0, GLsizei(count));
             glBindVertexArray(0);
             glDisable(GL_PROGRAM_POINT_SIZE);
@@ -79,7 +75,7 @@ public:
     }
 
 private:
-    GLuint pointsVao_ = 0;  // attribute-less: the vertex shader reads the instance buffer
+    kiln::gl::VertexArrayHandle pointsVao_;  // attribute-less: the vertex shader reads the instance buffer
     // What the wood texture was last baked from (a cache: a reload starts over).
     GLuint bakedTexture_ = 0, bakedWith_ = 0;
     glm::vec4 bakedLight_{-1.0f}, bakedDark_{-1.0f};

@@ -54,10 +54,6 @@ namespace {
 
 class Voxelize final : public kiln::Pass {
 public:
-    ~Voxelize() override {
-        if (fbo_) glDeleteFramebuffers(1, &fbo_);
-    }
-
     kiln::PassDeclaration declare() const override {
         using namespace kiln;
         PassDeclaration d;
@@ -114,13 +110,13 @@ public:
         for (const char* sum : kSums) glClearTexImage(ctx.internal(sum).id, 0, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
 
         // 1–3: rasterise into the sums (no attachments: the fragment shader only does atomics).
-        if (!fbo_) glCreateFramebuffers(1, &fbo_);
+        if (!fbo_) fbo_ = kiln::gl::createFramebuffer();
         if (fboSize_ != res) {
-            glNamedFramebufferParameteri(fbo_, GL_FRAMEBUFFER_DEFAULT_WIDTH, res);
-            glNamedFramebufferParameteri(fbo_, GL_FRAMEBUFFER_DEFAULT_HEIGHT, res);
+            glNamedFramebufferParameteri(fbo_.id(), GL_FRAMEBUFFER_DEFAULT_WIDTH, res);
+            glNamedFramebufferParameteri(fbo_.id(), GL_FRAMEBUFFER_DEFAULT_HEIGHT, res);
             fboSize_ = res;
         }
-        glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+        glBindFramebuffer(GL_FRAMEBUFFER, fbo_.id());
         glViewport(0, 0, res, res);
         glDisable(GL_DEPTH_TEST);
         glDisable(GL_CULL_FACE);
@@ -176,7 +172,6 @@ public:
         glBindImageTexture(firstResolved + 2, ctx.output("normal").id, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA16F);
         const GLuint groups = GLuint((res + 3) / 4);
         glDispatchCompute(groups, groups, groups);
-        glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
         for (GLuint i = 0; i < firstResolved + 3; ++i) glBindImageTexture(i, 0, 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32UI);
     }
 
@@ -191,7 +186,7 @@ private:
                                std::string_view(kSums[i]).starts_with("normal") ? GL_R32I : GL_R32UI);
     }
 
-    GLuint fbo_ = 0;  // attachment-less; a GL cache only (a reload makes a new one)
+    kiln::gl::FramebufferHandle fbo_;  // attachment-less; a GL cache only (a reload makes a new one)
     int fboSize_ = 0;
 };
 

@@ -69,6 +69,7 @@ void deleteVertexArray(GLuint);
 void deleteProgram(GLuint);
 void deleteShader(GLuint);
 void deleteQuery(GLuint);
+void deleteSampler(GLuint);
 }  // namespace detail
 
 using BufferHandle = Handle<detail::deleteBuffer>;
@@ -77,6 +78,12 @@ using VertexArrayHandle = Handle<detail::deleteVertexArray>;
 using ProgramHandle = Handle<detail::deleteProgram>;
 using ShaderHandle = Handle<detail::deleteShader>;
 using QueryHandle = Handle<detail::deleteQuery>;
+using SamplerHandle = Handle<detail::deleteSampler>;
+
+// New, empty objects with one owner each (glCreate*: DSA names, usable at once).
+FramebufferHandle createFramebuffer();
+VertexArrayHandle createVertexArray();
+SamplerHandle createSampler();
 
 // A texture with its shape, so binding code never has to ask GL.
 class Texture {
