@@ -304,6 +304,15 @@ void Runtime::renderFrame(const SceneView& view, const SceneDraw& scene, const F
     recoverFromFaults();
 }
 
+// The barrier between passes is the host's, not each producer's: after a pass runs,
+// whatever it wrote (image stores, attachments, copies) is made visible to every way a
+// later pass or a read-back can read it. No slot declares how it is read (fetch, image
+// load, attachment), so the host covers them all; a barrier with nothing outstanding
+// costs little. Barriers between a pass's own dispatches stay the pass's.
+constexpr GLbitfield kWrittenVisibleToLaterPasses = GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
+                                                    GL_TEXTURE_UPDATE_BARRIER_BIT | GL_FRAMEBUFFER_BARRIER_BIT |
+                                                    GL_PIXEL_BUFFER_BARRIER_BIT;
+
 void Runtime::runPass(size_t i, const FrameResources& shared, const SceneView& view, const FrameInfo& frame) {
     PassSlot& slot = *slots_[i];
     const graph::PlannedPass& planned = plan_->passes[i];
@@ -327,6 +336,7 @@ void Runtime::runPass(size_t i, const FrameResources& shared, const SceneView& v
         gl::DebugGroup group(slot.id);
         t.timer.begin();
         fault = guard::guarded([&] { slot.pass->execute(ctx); }, slot.library->watch());
+        glMemoryBarrier(kWrittenVisibleToLaterPasses);
         if (fault) {
             // What the pass left open is closed: its debug groups, its bindings.
             // (The host's own group for the pass stays: `group` pops it.)
