@@ -1,0 +1,97 @@
+// The pass author's manual (the comment at the top of kiln/pass.hpp) is compiled: its
+// example pass ships as passes/tint/ and shaders/tint/tint.frag, the text and the files
+// are checked to be the same, and the built module is run and its pixels checked.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "app/app.hpp"
+#include "kiln/image_io.hpp"
+#include "support/headless.hpp"
+
+namespace fs = std::filesystem;
+using namespace kiln;
+
+namespace {
+
+std::string readFile(const fs::path& p) {
+    std::ifstream in(p);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+// The lines of `header` from the one starting with `first` to the one starting with
+// `last` (both after the comment prefix "//     "), with that prefix removed.
+std::string manualExample(const std::string& header, const std::string& first, const std::string& last) {
+    const std::string prefix = "//     ";
+    std::istringstream lines(header);
+    std::string line, out;
+    bool inside = false;
+    while (std::getline(lines, line)) {
+        const bool example = line.rfind(prefix, 0) == 0;
+        const std::string text = example ? line.substr(prefix.size()) : "";
+        if (!inside && example && text.rfind(first, 0) == 0) inside = true;
+        if (!inside) continue;
+        if (!example) FAIL("the manual's example is cut by the line \"" << line << "\"");
+        out += text + "\n";
+        if (text.rfind(last, 0) == 0) return out;
+    }
+    FAIL("pass.hpp has no example from \"" << first << "\" to \"" << last << "\"");
+    return out;
+}
+
+}  // namespace
+
+TEST_CASE("the pass manual's example is passes/tint/ and shaders/tint/tint.frag, word for word", "[integration][files]") {
+    const fs::path root(KILN_SOURCE_DIR);
+    const std::string header = readFile(root / "host/include/kiln/pass.hpp");
+    CHECK(manualExample(header, "#include <kiln/pass.hpp>", "KILN_PASS_MODULE(tint, Tint)") ==
+          readFile(root / "passes/tint/tint.cpp"));
+    CHECK(manualExample(header, "#version 450 core", "void main()") == readFile(root / "shaders/tint/tint.frag"));
+    // The manual's CMake line, with <name> as tint.
+    CHECK(header.find("//   passes/<name>/CMakeLists.txt:   kiln_add_pass(<name> <name>.cpp)") != std::string::npos);
+    CHECK(readFile(root / "passes/tint/CMakeLists.txt") == "kiln_add_pass(tint tint.cpp)\n");
+}
+
+TEST_CASE("the manual's tint pass multiplies what it reads by its tint, its parameter from the pipeline", "[integration][gl]") {
+    REQUIRE(test::ensureHeadlessContext());
+    app::App app;
+    std::string error;
+    REQUIRE(app.init(test::pausedHeadlessOptions(32), error));
+    // composite.hdr (RGBA16F) in, so the ratio is exact up to half precision.
+    const std::string pipeline = R"({"output": "tint.color", "passes": [
+          {"id": "gbuffer", "module": "gbuffer"},
+          {"id": "composite", "module": "composite",
+           "inputs": {"albedo": "gbuffer.albedo", "normal": "gbuffer.normal", "depth": "gbuffer.depth"}},
+          {"id": "tint", "module": "tint", "params": {"tint": [0.25, 1.0, 2.0]}, "inputs": {"color": "composite.hdr"}}]})";
+    app.runtime().setRequested({"composite.hdr"});
+    std::string errors;
+    INFO(errors);
+    REQUIRE(app.runtime().loadPipelineText(pipeline, "manual.json", errors));
+    app.frame();
+    for (auto& e : app.runtime().activeErrors()) FAIL(e);
+    const TextureRef* in = app.runtime().findTexture("composite", "hdr");
+    const TextureRef* out = app.runtime().findTexture("tint", "color");
+    REQUIRE(in);
+    REQUIRE(out);
+    const FloatImage before = readTexture(in->id, in->target, in->format, in->width, in->height);
+    const FloatImage after = readTexture(out->id, out->target, out->format, out->width, out->height);
+    REQUIRE(after.width == before.width);
+    const float tint[3] = {0.25f, 1.0f, 2.0f};
+    int lit = 0;
+    for (int y = 0; y < after.height; ++y)
+        for (int x = 0; x < after.width; ++x)
+            for (int c = 0; c < 3; ++c) {
+                const float expected = before.at(x, y)[c] * tint[c];
+                // Both are RGBA16F: 2^-10 relative per value, twice; same pixel centres.
+                INFO("pixel " << x << "," << y << " channel " << c);
+                REQUIRE(std::abs(after.at(x, y)[c] - expected) <= 2e-3f * std::abs(expected) + 1e-6f);
+                lit += expected > 0.01f;
+            }
+    CHECK(lit > after.width * after.height);  // the box is lit: the check compared real values
+}
