@@ -14,6 +14,7 @@
 
 #include "app/app.hpp"
 #include "app/context.hpp"
+#include "app/editable_copy.hpp"
 #include "kiln/log.hpp"
 
 namespace fs = std::filesystem;
@@ -21,19 +22,6 @@ using namespace kiln;
 using Clock = std::chrono::steady_clock;
 
 namespace {
-
-std::string slurp(const fs::path& p) {
-    std::ifstream in(p);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
-void save(const fs::path& p, const std::string& text) {
-    const fs::path tmp = p.parent_path() / ("." + p.filename().string() + ".new");
-    std::ofstream(tmp, std::ios::trunc | std::ios::binary) << text;
-    fs::rename(tmp, p);
-}
 
 glm::vec3 centrePixel(app::App& app) {
     const TextureRef* t = app.displayedTexture();
@@ -75,11 +63,9 @@ int main(int argc, char** argv) {
         return 1;
     }
     log::setMinLevel(log::Level::Error);
-    const fs::path root = fs::temp_directory_path() / ("kiln-bench-live-" + std::to_string(getpid()));
-    fs::remove_all(root);
-    fs::create_directories(root / "modules");
-    fs::copy(fs::path(KILN_SOURCE_DIR) / "shaders", root / "shaders", fs::copy_options::recursive);
-    fs::copy(fs::path(KILN_SOURCE_DIR) / "pipelines", root / "pipelines", fs::copy_options::recursive);
+    const app::EditableCopy copy(fs::temp_directory_path() / ("kiln-bench-live-" + std::to_string(getpid())),
+                                 KILN_SOURCE_DIR);
+    const fs::path& root = copy.root();
     const fs::path v1 = fs::path(LIVE_MODULE_BUILDS) / "tint_v1.so", v2 = fs::path(LIVE_MODULE_BUILDS) / "tint_v2.so";
     const bool haveModules = fs::exists(v1) && fs::exists(v2);
     if (haveModules) fs::copy_file(v1, root / "modules/libpass_live_tint.so");
@@ -89,9 +75,7 @@ int main(int argc, char** argv) {
         app::applyDefaults(o);
         o.headless = true;
         o.paused = true;
-        o.shaderRoot = (root / "shaders").string();
-        o.pipeline = (root / "pipelines" / pipeline).string();
-        o.moduleDir = (root / "modules").string() + ":" + o.moduleDir;
+        copy.pointAt(o, pipeline);
         return a.init(o, error);
     };
     std::vector<std::pair<std::string, std::vector<double>>> results;
@@ -101,20 +85,20 @@ int main(int argc, char** argv) {
         if (!makeApp("default.json", a)) return std::fprintf(stderr, "kiln-bench-live: error: %s\n", error.c_str()), 1;
         a.frame();
         const fs::path frag = root / "shaders/composite/composite.frag";
-        const std::string original = slurp(frag);
+        const std::string original = app::readWholeFile(frag);
         const std::string body = original.substr(0, original.rfind('}'));
         std::vector<double> ms;
         for (int i = 0; i < trials; ++i) {
             const bool odd = i % 2;
-            save(frag, body + (odd ? "    o_color = vec4(1.0, 0.0, 1.0, 1.0);\n}\n" : "    o_color = vec4(0.0, 1.0, 0.0, 1.0);\n}\n"));
+            app::saveByRename(frag, body + (odd ? "    o_color = vec4(1.0, 0.0, 1.0, 1.0);\n}\n" : "    o_color = vec4(0.0, 1.0, 0.0, 1.0);\n}\n"));
             ms.push_back(until(a, odd ? glm::vec3(1, 0, 1) : glm::vec3(0, 1, 0), Clock::now()));
         }
-        save(frag, original);
+        app::saveByRename(frag, original);
         results.push_back({"shader edit", ms});
     }
     {  // Pipeline edit: composite's exposure alternates between 0.3 and 1.
         const fs::path file = root / "pipelines/default.json";
-        std::string text = slurp(file);
+        std::string text = app::readWholeFile(file);
         app::App a;
         if (!makeApp("default.json", a)) return 1;
         a.frame();
@@ -124,7 +108,7 @@ int main(int argc, char** argv) {
             std::string edited = text;
             const std::string from = "\"exposure\": 1.0";
             edited.replace(edited.find(from), from.size(), i % 2 == 0 ? "\"exposure\": 0.3" : "\"exposure\": 1.0");
-            save(file, edited);
+            app::saveByRename(file, edited);
             ms.push_back(until(a, before, Clock::now(), /*away=*/true));
         }
         results.push_back({"pipeline edit", ms});
@@ -135,16 +119,15 @@ int main(int argc, char** argv) {
         app::App a;
         if (!makeApp("tint.json", a)) return std::fprintf(stderr, "kiln-bench-live: error: %s\n", error.c_str()), 1;
         a.frame();
-        const std::string bytes[2] = {slurp(v1), slurp(v2)};
+        const std::string bytes[2] = {app::readWholeFile(v1), app::readWholeFile(v2)};
         std::vector<double> ms;
         for (int i = 0; i < trials; ++i) {
             const int next = (i + 1) % 2;  // starts on v1: first swap installs v2
-            save(root / "modules/libpass_live_tint.so", bytes[next]);
+            app::saveByRename(root / "modules/libpass_live_tint.so", bytes[next]);
             ms.push_back(until(a, next == 0 ? glm::vec3(1, 0.25f, 0) : glm::vec3(0, 0.25f, 1), Clock::now()));
         }
         results.push_back({"module swap", ms});
     }
-    fs::remove_all(root);
 
     fs::create_directories(outDir);
     std::ofstream csv(fs::path(outDir) / "live.csv");

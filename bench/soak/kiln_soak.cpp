@@ -20,12 +20,14 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "app/app.hpp"
 #include "app/context.hpp"
+#include "app/editable_copy.hpp"
 #include "kiln/gl.hpp"
 #include "kiln/image_io.hpp"
 #include "kiln/log.hpp"
@@ -35,20 +37,6 @@ using namespace kiln;
 using Clock = std::chrono::steady_clock;
 
 namespace {
-
-std::string slurp(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
-// An editor's save: a temporary file renamed over the original.
-void save(const fs::path& p, const std::string& text) {
-    const fs::path tmp = p.parent_path() / ("." + p.filename().string() + ".new");
-    std::ofstream(tmp, std::ios::trunc | std::ios::binary) << text;
-    fs::rename(tmp, p);
-}
 
 size_t countEntries(const char* dir) {
     std::error_code ec;
@@ -118,32 +106,233 @@ struct Sample {
     size_t textures = 0, fds = 0, threads = 0;
 };
 
-}  // namespace
+Sample sample(const run::Runtime& rt, uint64_t frame) {
+    Sample s;
+    s.frame = frame;
+    s.rss = rssBytes();
+    s.glBytes = textureBytes(rt, s.textures);
+    s.glErrors = gl::debugErrorCount();
+    s.fds = countEntries("/proc/self/fd");
+    s.threads = countEntries("/proc/self/task");
+    return s;
+}
 
-int main(int argc, char** argv) {
+std::string toJson(const Sample& x) {
+    return "{\"frame\": " + std::to_string(x.frame) + ", \"rss_bytes\": " + std::to_string(x.rss) +
+           ", \"texture_bytes\": " + std::to_string(x.glBytes) + ", \"textures\": " + std::to_string(x.textures) +
+           ", \"fds\": " + std::to_string(x.fds) + ", \"threads\": " + std::to_string(x.threads) + "}";
+}
+
+struct Options {
     int frames = 10000, width = 64, height = 64, scanEvery = 500, rounds = 3;
     bool trace = false;
     double rssToleranceMb = 16.0;
     std::string outDir = "bench-out";
+};
+
+std::optional<Options> parseOptions(int argc, char** argv) {
+    Options o;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
         const bool hasValue = i + 1 < argc;
-        if (a == "--frames" && hasValue) frames = std::atoi(argv[++i]);
-        else if (a == "--size" && hasValue && std::sscanf(argv[++i], "%dx%d", &width, &height) == 2) {}
-        else if (a == "--scan-every" && hasValue) scanEvery = std::atoi(argv[++i]);
-        else if (a == "--rss-tolerance-mb" && hasValue) rssToleranceMb = std::atof(argv[++i]);
-        else if (a == "--out" && hasValue) outDir = argv[++i];
-        else if (a == "--edit-rounds" && hasValue) rounds = std::atoi(argv[++i]);
-        else if (a == "--trace") trace = true;
+        if (a == "--frames" && hasValue) o.frames = std::atoi(argv[++i]);
+        else if (a == "--size" && hasValue && std::sscanf(argv[++i], "%dx%d", &o.width, &o.height) == 2) {}
+        else if (a == "--scan-every" && hasValue) o.scanEvery = std::atoi(argv[++i]);
+        else if (a == "--rss-tolerance-mb" && hasValue) o.rssToleranceMb = std::atof(argv[++i]);
+        else if (a == "--out" && hasValue) o.outDir = argv[++i];
+        else if (a == "--edit-rounds" && hasValue) o.rounds = std::atoi(argv[++i]);
+        else if (a == "--trace") o.trace = true;
         else {
             std::fprintf(stderr, "kiln-soak: error: unknown or incomplete option \"%s\"\n", a.c_str());
-            return 2;
+            return std::nullopt;
         }
     }
-    if (frames < 100 || width < 8 || height < 8 || width > 4096 || height > 4096 || scanEvery < 1) {
-        std::fprintf(stderr, "kiln-soak: error: --frames ≥ 100, --size from 8x8 to 4096x4096, --scan-every ≥ 1\n");
-        return 2;
+    if (o.frames < 300 || o.width < 8 || o.height < 8 || o.width > 4096 || o.height > 4096 || o.scanEvery < 1) {
+        std::fprintf(stderr, "kiln-soak: error: --frames ≥ 300 (100 of warm-up, then a stretch before and after the edits), --size from 8x8 to 4096x4096, --scan-every ≥ 1\n");
+        return std::nullopt;
     }
+    return o;
+}
+
+// The three files the burst edits (in the editable copy), with their original text.
+struct EditedFiles {
+    fs::path frag, pipeline, scene;
+    std::string fragText, pipelineText, sceneText;
+    explicit EditedFiles(const fs::path& root)
+        : frag(root / "shaders/composite/composite.frag"), pipeline(root / "pipelines/default.json"),
+          scene(root / "scenes/cornell.json"), fragText(app::readWholeFile(frag)),
+          pipelineText(app::readWholeFile(pipeline)), sceneText(app::readWholeFile(scene)) {}
+};
+
+// The run: frames, samples, the burst of edits in the middle; then what it found.
+class Soak {
+public:
+    Soak(app::App& app, const Options& o, const EditedFiles& files) : app_(app), o_(o), files_(files) {}
+
+    void run() {
+        const uint64_t errorsAtStart = gl::debugErrorCount();
+        const auto t0 = Clock::now();
+        warmup_ = std::max(100, o_.frames / 10);
+        burstAt_ = o_.frames / 2;
+        burstEnd_ = o_.frames;
+        bool burstDone = false;
+        while (frame_ < o_.frames) {
+            app_.frame();
+            ++frame_;
+            if (frame_ == warmup_) atWarmup_ = sample(app_.runtime(), frame_);
+            if (frame_ >= warmup_ && frame_ % 10 == 0) rssTrace_.push_back({frame_, rssBytes()});
+            if (frame_ % o_.scanEvery == 0) scan();
+            if (frame_ >= burstAt_ && !burstDone) {
+                burstDone = true;
+                for (int round = 0; round < o_.rounds; ++round) (editRound() ? editsApplied_ : editsMissed_) += 6;
+                burstEnd_ = frame_;
+            }
+        }
+        seconds_ = std::chrono::duration<double>(Clock::now() - t0).count();
+        scan();
+        atEnd_ = sample(app_.runtime(), frame_);
+        glErrors_ = gl::debugErrorCount() - errorsAtStart;
+    }
+
+    std::vector<std::string> problems() const {
+        const double tolerance = o_.rssToleranceMb;
+        std::vector<std::string> p;
+        if (growthBefore() > tolerance) p.push_back("RSS grew " + std::to_string(growthBefore()) + " MiB before the edits");
+        if (stepAcross() > tolerance) p.push_back("RSS rose " + std::to_string(stepAcross()) + " MiB across the edits");
+        if (growthAfter() > tolerance) p.push_back("RSS grew " + std::to_string(growthAfter()) + " MiB after the edits");
+        if (atEnd_.glBytes != atWarmup_.glBytes) p.push_back("texture bytes changed after warm-up");
+        if (atEnd_.textures != atWarmup_.textures) p.push_back("texture count changed after warm-up");
+        if (atEnd_.fds > atWarmup_.fds) p.push_back("open file descriptors grew");
+        if (atEnd_.threads > atWarmup_.threads) p.push_back("threads grew");
+        if (glErrors_) p.push_back(std::to_string(glErrors_) + " GL errors");
+        if (nanCount_) p.push_back(std::to_string(nanCount_) + " NaN/Inf values (first in " + nanWhere_ + ")");
+        if (editsMissed_)
+            p.push_back(std::to_string(editsMissed_) + " live edits not applied within " +
+                        std::to_string(kEditDeadline.count()) + " s");
+        return p;
+    }
+
+    void printTable() const {
+        std::printf("kiln-soak: %d frames at %dx%d in %.1f s (%.0f frames/s), live edits applied %d, missed %d\n", frame_,
+                    o_.width, o_.height, seconds_, frame_ / seconds_, editsApplied_, editsMissed_);
+        std::printf("  %-22s %14s %14s %12s\n", "", "warm-up", "end", "tolerance");
+        std::printf("  %-22s %14llu %14llu %12s\n", "frame", (unsigned long long)atWarmup_.frame,
+                    (unsigned long long)atEnd_.frame, "");
+        std::printf("  %-22s %14.1f %14.1f %12s\n", "RSS (MiB)", atWarmup_.rss / 1048576.0, atEnd_.rss / 1048576.0, "");
+        std::printf("  %-22s %14.1f %14.1f %12s\n", "RSS mean, first/last", meanMib(warmup_, preMid()),
+                    meanMib(postMid(), frame_ + 1), "");
+        const std::string tol = "+" + std::to_string(int(o_.rssToleranceMb));
+        std::printf("  %-22s %14s %14.1f %12s\n", "RSS growth before edits", "", growthBefore(), tol.c_str());
+        std::printf("  %-22s %14s %14.1f %12s\n", "RSS step across edits", "", stepAcross(), tol.c_str());
+        std::printf("  %-22s %14s %14.1f %12s\n", "RSS growth after edits", "", growthAfter(), tol.c_str());
+        std::printf("  %-22s %14llu %14llu %12s\n", "texture bytes", (unsigned long long)atWarmup_.glBytes,
+                    (unsigned long long)atEnd_.glBytes, "equal");
+        std::printf("  %-22s %14zu %14zu %12s\n", "textures", atWarmup_.textures, atEnd_.textures, "equal");
+        std::printf("  %-22s %14zu %14zu %12s\n", "open fds", atWarmup_.fds, atEnd_.fds, "no growth");
+        std::printf("  %-22s %14zu %14zu %12s\n", "threads", atWarmup_.threads, atEnd_.threads, "no growth");
+        std::printf("  %-22s %14s %14llu %12s\n", "GL errors", "", (unsigned long long)glErrors_, "0");
+        std::printf("  %-22s %14s %14zu %12s\n", ("NaN/Inf (" + std::to_string(scans_) + " scans)").c_str(), "",
+                    nanCount_, "0");
+    }
+
+    void writeJson(const fs::path& file, bool ok) const {
+        const double rssGrowthMb = std::max({growthBefore(), stepAcross(), growthAfter()});
+        std::ofstream json(file);
+        json << "{\n  \"frames\": " << frame_ << ",\n  \"width\": " << o_.width << ",\n  \"height\": " << o_.height
+             << ",\n  \"seconds\": " << seconds_ << ",\n  \"warmup\": " << toJson(atWarmup_)
+             << ",\n  \"end\": " << toJson(atEnd_)
+             << ",\n  \"rss_mean_first_bytes\": " << uint64_t(meanMib(warmup_, preMid()) * (1 << 20))
+             << ",\n  \"rss_mean_last_bytes\": " << uint64_t(meanMib(postMid(), frame_ + 1) * (1 << 20))
+             << ",\n  \"rss_growth_before_edits_mib\": " << growthBefore()
+             << ",\n  \"rss_step_across_edits_mib\": " << stepAcross()
+             << ",\n  \"rss_growth_after_edits_mib\": " << growthAfter() << ",\n  \"rss_growth_mib\": " << rssGrowthMb
+             << ",\n  \"rss_tolerance_mib\": " << o_.rssToleranceMb << ",\n  \"gl_errors\": " << glErrors_
+             << ",\n  \"nan_inf\": " << nanCount_ << ",\n  \"scans\": " << scans_
+             << ",\n  \"live_edits_applied\": " << editsApplied_ << ",\n  \"live_edits_missed\": " << editsMissed_
+             << ",\n  \"ok\": " << (ok ? "true" : "false") << "\n}\n";
+    }
+
+private:
+    // A live edit is applied by the watcher after its debounce, so the burst waits in
+    // real time: generously, since a busy machine (a parallel ctest) slows every frame.
+    static constexpr std::chrono::seconds kEditDeadline{60};
+
+    void scan() {
+        ++scans_;
+        nanCount_ += nonFinite(app_.runtime(), nanWhere_);
+        if (o_.trace) std::printf("  frame %6d  RSS %7.1f MiB\n", frame_, rssBytes() / 1048576.0);
+    }
+
+    // Frames until `done` (or the deadline).
+    bool framesUntil(const std::function<bool()>& done) {
+        const auto t0 = Clock::now();
+        while (!done() && Clock::now() - t0 < kEditDeadline) {
+            app_.frame();
+            ++frame_;
+        }
+        return done();
+    }
+
+    // A shader, a pipeline parameter and a scene edit, applied, then reverted, waiting
+    // for the watcher each time. True when all six reloads happened.
+    bool editRound() {
+        auto& live = app_.live();
+        const int s0 = live.shaderReloads, p0 = live.pipelineReloads, c0 = live.sceneReloads;
+        app::saveByRename(files_.frag, files_.fragText.substr(0, files_.fragText.rfind('}')) + "    o_color.rgb *= 0.5;\n}\n");
+        std::string edited = files_.pipelineText;
+        if (const size_t at = edited.find("\"exposure\""); at != std::string::npos) {
+            const size_t colon = edited.find(':', at), end = edited.find_first_of(",}\n", colon);
+            edited.replace(colon + 1, end - colon - 1, " 0.5");
+        }
+        app::saveByRename(files_.pipeline, edited);
+        app::saveByRename(files_.scene, files_.sceneText + "\n");  // same scene, new bytes: a reload (world reset)
+        const bool applied = framesUntil(
+            [&] { return live.shaderReloads > s0 && live.pipelineReloads > p0 && live.sceneReloads > c0; });
+        app::saveByRename(files_.frag, files_.fragText);
+        app::saveByRename(files_.pipeline, files_.pipelineText);
+        app::saveByRename(files_.scene, files_.sceneText);
+        const bool reverted = framesUntil([&] {
+            return live.shaderReloads > s0 + 1 && live.pipelineReloads > p0 + 1 && live.sceneReloads > c0 + 1;
+        });
+        return applied && reverted;
+    }
+
+    // RSS moves by ±10 MiB from frame to frame (the driver's allocations), so growth
+    // compares the means of neighbouring stretches, not single readings. A leak grows
+    // with frames: before the burst and after it, each stretch's second half against
+    // its first; what the edits cost once (new programs, the driver's caches) is the
+    // step across the burst.
+    double meanMib(int from, int to) const {
+        double sum = 0;
+        int n = 0;
+        for (auto& [f, rss] : rssTrace_)
+            if (f >= from && f < to) sum += double(rss), ++n;
+        return n ? sum / n / (1 << 20) : 0.0;
+    }
+    int preMid() const { return (warmup_ + burstAt_) / 2; }
+    int postMid() const { return (burstEnd_ + frame_) / 2; }
+    double growthBefore() const { return meanMib(preMid(), burstAt_) - meanMib(warmup_, preMid()); }
+    double stepAcross() const { return meanMib(burstEnd_, postMid()) - meanMib(preMid(), burstAt_); }
+    double growthAfter() const { return meanMib(postMid(), frame_ + 1) - meanMib(burstEnd_, postMid()); }
+
+    app::App& app_;
+    const Options& o_;
+    const EditedFiles& files_;
+    int frame_ = 0, warmup_ = 0, burstAt_ = 0, burstEnd_ = 0;
+    int editsApplied_ = 0, editsMissed_ = 0;
+    size_t nanCount_ = 0, scans_ = 0;
+    std::string nanWhere_;
+    Sample atWarmup_, atEnd_;
+    uint64_t glErrors_ = 0;
+    double seconds_ = 0;
+    std::vector<std::pair<int, uint64_t>> rssTrace_;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    const std::optional<Options> options = parseOptions(argc, argv);
+    if (!options) return 2;
     std::string error;
     auto context = app::HeadlessContext::create(/*debug=*/true, error);
     if (!context) {
@@ -152,181 +341,27 @@ int main(int argc, char** argv) {
     }
     log::setMinLevel(log::Level::Error);
 
-    // Temporary copies the edits go to (the real watcher watches them).
-    const fs::path root = fs::temp_directory_path() / ("kiln-soak-" + std::to_string(getpid()));
-    fs::remove_all(root);
-    fs::create_directories(root / "scenes");
-    fs::copy(fs::path(KILN_SOURCE_DIR) / "shaders", root / "shaders", fs::copy_options::recursive);
-    fs::copy(fs::path(KILN_SOURCE_DIR) / "pipelines", root / "pipelines", fs::copy_options::recursive);
-    fs::copy_file(fs::path(KILN_SOURCE_DIR) / "scenes/cornell.json", root / "scenes/cornell.json");
-    const fs::path frag = root / "shaders/composite/composite.frag", pipeline = root / "pipelines/default.json",
-                   scene = root / "scenes/cornell.json";
-    const std::string fragText = slurp(frag), pipelineText = slurp(pipeline), sceneText = slurp(scene);
-
+    const app::EditableCopy copy(fs::temp_directory_path() / ("kiln-soak-" + std::to_string(getpid())), KILN_SOURCE_DIR);
+    const EditedFiles files(copy.root());
     app::Options o;
     app::applyDefaults(o);
     o.headless = true;
-    o.width = width, o.height = height;
-    o.shaderRoot = (root / "shaders").string();
-    o.pipeline = pipeline.string();
-    o.scene = scene.string();
-    int status = 0;
-    {
-        app::App app;
-        if (!app.init(o, error)) {
-            std::fprintf(stderr, "kiln-soak: error: %s\n", error.c_str());
-            fs::remove_all(root);
-            return 1;
-        }
-        run::Runtime& rt = app.runtime();
-        auto sample = [&](uint64_t frame) {
-            Sample s;
-            s.frame = frame;
-            s.rss = rssBytes();
-            s.glBytes = textureBytes(rt, s.textures);
-            s.glErrors = gl::debugErrorCount();
-            s.fds = countEntries("/proc/self/fd");
-            s.threads = countEntries("/proc/self/task");
-            return s;
-        };
-        // Frames until `done` (or 10 s): a live edit is applied by the watcher after its
-        // debounce, so this waits in real time.
-        auto until = [&](int& frame, const std::function<bool()>& done) {
-            const auto t0 = Clock::now();
-            while (!done() && Clock::now() - t0 < std::chrono::seconds(10)) {
-                app.frame();
-                ++frame;
-            }
-            return done();
-        };
-        const uint64_t errorsAtStart = gl::debugErrorCount();
-        const int warmup = std::max(100, frames / 10), burstAt = frames / 2;
-        size_t nanCount = 0, scans = 0;
-        std::string nanWhere;
-        int editsApplied = 0, editsMissed = 0;
-        Sample atWarmup, atEnd;
-        const auto t0 = Clock::now();
-        int frame = 0;
-        bool burstDone = false;
-        int burstEnd = frames;
-        // RSS every 10 frames: it moves by ±10 MiB from frame to frame (the driver's
-        // allocations), so growth compares the mean of the first quarter after warm-up
-        // with the mean of the last quarter, not two single readings.
-        std::vector<std::pair<int, uint64_t>> rssTrace;
-        while (frame < frames) {
-            app.frame();
-            ++frame;
-            if (frame == warmup) atWarmup = sample(frame);
-            if (frame >= warmup && frame % 10 == 0) rssTrace.push_back({frame, rssBytes()});
-            if (frame % scanEvery == 0) {
-                ++scans;
-                nanCount += nonFinite(rt, nanWhere);
-                if (trace) std::printf("  frame %6d  RSS %7.1f MiB\n", frame, rssBytes() / 1048576.0);
-            }
-            if (frame >= burstAt && !burstDone) {
-                burstDone = true;
-                // The burst: three rounds of shader, pipeline and scene edits, each
-                // applied and then reverted, waiting for the watcher each time.
-                auto& live = app.live();
-                for (int round = 0; round < rounds; ++round) {
-                    const int s0 = live.shaderReloads, p0 = live.pipelineReloads, c0 = live.sceneReloads;
-                    save(frag, fragText.substr(0, fragText.rfind('}')) + "    o_color.rgb *= 0.5;\n}\n");
-                    std::string edited = pipelineText;
-                    const size_t at = edited.find("\"exposure\"");
-                    if (at != std::string::npos) {
-                        const size_t colon = edited.find(':', at), end = edited.find_first_of(",}\n", colon);
-                        edited.replace(colon + 1, end - colon - 1, " 0.5");
-                    }
-                    save(pipeline, edited);
-                    save(scene, sceneText + "\n");  // same scene, new bytes: a reload (world reset)
-                    const bool applied = until(frame, [&] {
-                        return live.shaderReloads > s0 && live.pipelineReloads > p0 && live.sceneReloads > c0;
-                    });
-                    save(frag, fragText);
-                    save(pipeline, pipelineText);
-                    save(scene, sceneText);
-                    const bool reverted = until(frame, [&] {
-                        return live.shaderReloads > s0 + 1 && live.pipelineReloads > p0 + 1 && live.sceneReloads > c0 + 1;
-                    });
-                    (applied && reverted ? editsApplied : editsMissed) += 6;
-                }
-                burstEnd = frame;
-            }
-        }
-        const double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
-        ++scans;
-        nanCount += nonFinite(rt, nanWhere);
-        atEnd = sample(frame);
-        const uint64_t glErrors = gl::debugErrorCount() - errorsAtStart;
-        // A leak grows with frames: before the burst and after it, the second half of the
-        // stretch against its first half. What the edits cost once (new programs, the
-        // driver's caches for them) is the step across the burst.
-        auto meanMib = [&](int from, int to) {
-            double sum = 0;
-            int n = 0;
-            for (auto& [f, rss] : rssTrace)
-                if (f >= from && f < to) sum += double(rss), ++n;
-            return n ? sum / n / (1 << 20) : 0.0;
-        };
-        const int preMid = (warmup + burstAt) / 2, postMid = (burstEnd + frame) / 2;
-        const double early = meanMib(warmup, preMid) * (1 << 20), late = meanMib(postMid, frame + 1) * (1 << 20);
-        const double growthBefore = meanMib(preMid, burstAt) - meanMib(warmup, preMid);
-        const double stepAcross = meanMib(burstEnd, postMid) - meanMib(preMid, burstAt);
-        const double growthAfter = meanMib(postMid, frame + 1) - meanMib(burstEnd, postMid);
-        const double rssGrowthMb = std::max({growthBefore, stepAcross, growthAfter});
-
-        std::vector<std::string> problems;
-        if (growthBefore > rssToleranceMb) problems.push_back("RSS grew " + std::to_string(growthBefore) + " MiB before the edits");
-        if (stepAcross > rssToleranceMb) problems.push_back("RSS rose " + std::to_string(stepAcross) + " MiB across the edits");
-        if (growthAfter > rssToleranceMb) problems.push_back("RSS grew " + std::to_string(growthAfter) + " MiB after the edits");
-        if (atEnd.glBytes != atWarmup.glBytes) problems.push_back("texture bytes changed after warm-up");
-        if (atEnd.textures != atWarmup.textures) problems.push_back("texture count changed after warm-up");
-        if (atEnd.fds > atWarmup.fds) problems.push_back("open file descriptors grew");
-        if (atEnd.threads > atWarmup.threads) problems.push_back("threads grew");
-        if (glErrors) problems.push_back(std::to_string(glErrors) + " GL errors");
-        if (nanCount) problems.push_back(std::to_string(nanCount) + " NaN/Inf values (first in " + nanWhere + ")");
-        if (editsMissed) problems.push_back(std::to_string(editsMissed) + " live edits not applied within 10 s");
-        status = problems.empty() ? 0 : 1;
-
-        std::printf("kiln-soak: %d frames at %dx%d in %.1f s (%.0f frames/s), live edits applied %d, missed %d\n", frame,
-                    width, height, seconds, frame / seconds, editsApplied, editsMissed);
-        std::printf("  %-22s %14s %14s %12s\n", "", "warm-up", "end", "tolerance");
-        std::printf("  %-22s %14llu %14llu %12s\n", "frame", (unsigned long long)atWarmup.frame, (unsigned long long)atEnd.frame, "");
-        std::printf("  %-22s %14.1f %14.1f %12s\n", "RSS (MiB)", atWarmup.rss / 1048576.0, atEnd.rss / 1048576.0, "");
-        std::printf("  %-22s %14.1f %14.1f %12s\n", "RSS mean, first/last", early / 1048576.0, late / 1048576.0, "");
-        const std::string tol = "+" + std::to_string(int(rssToleranceMb));
-        std::printf("  %-22s %14s %14.1f %12s\n", "RSS growth before edits", "", growthBefore, tol.c_str());
-        std::printf("  %-22s %14s %14.1f %12s\n", "RSS step across edits", "", stepAcross, tol.c_str());
-        std::printf("  %-22s %14s %14.1f %12s\n", "RSS growth after edits", "", growthAfter, tol.c_str());
-        std::printf("  %-22s %14llu %14llu %12s\n", "texture bytes", (unsigned long long)atWarmup.glBytes,
-                    (unsigned long long)atEnd.glBytes, "equal");
-        std::printf("  %-22s %14zu %14zu %12s\n", "textures", atWarmup.textures, atEnd.textures, "equal");
-        std::printf("  %-22s %14zu %14zu %12s\n", "open fds", atWarmup.fds, atEnd.fds, "no growth");
-        std::printf("  %-22s %14zu %14zu %12s\n", "threads", atWarmup.threads, atEnd.threads, "no growth");
-        std::printf("  %-22s %14s %14llu %12s\n", "GL errors", "", (unsigned long long)glErrors, "0");
-        std::printf("  %-22s %14s %14zu %12s\n", ("NaN/Inf (" + std::to_string(scans) + " scans)").c_str(), "", nanCount, "0");
-        for (auto& p : problems) std::printf("kiln-soak: FAIL: %s\n", p.c_str());
-        if (problems.empty()) std::printf("kiln-soak: ok\n");
-
-        std::error_code ec;
-        fs::create_directories(outDir, ec);
-        std::ofstream json(fs::path(outDir) / "soak.json");
-        auto s = [](const Sample& x) {
-            return "{\"frame\": " + std::to_string(x.frame) + ", \"rss_bytes\": " + std::to_string(x.rss) +
-                   ", \"texture_bytes\": " + std::to_string(x.glBytes) + ", \"textures\": " + std::to_string(x.textures) +
-                   ", \"fds\": " + std::to_string(x.fds) + ", \"threads\": " + std::to_string(x.threads) + "}";
-        };
-        json << "{\n  \"frames\": " << frame << ",\n  \"width\": " << width << ",\n  \"height\": " << height
-             << ",\n  \"seconds\": " << seconds << ",\n  \"warmup\": " << s(atWarmup) << ",\n  \"end\": " << s(atEnd)
-             << ",\n  \"rss_mean_first_bytes\": " << uint64_t(early)
-             << ",\n  \"rss_mean_last_bytes\": " << uint64_t(late) << ",\n  \"rss_growth_before_edits_mib\": " << growthBefore
-             << ",\n  \"rss_step_across_edits_mib\": " << stepAcross << ",\n  \"rss_growth_after_edits_mib\": " << growthAfter
-             << ",\n  \"rss_growth_mib\": " << rssGrowthMb << ",\n  \"rss_tolerance_mib\": " << rssToleranceMb
-             << ",\n  \"gl_errors\": " << glErrors << ",\n  \"nan_inf\": " << nanCount << ",\n  \"scans\": " << scans
-             << ",\n  \"live_edits_applied\": " << editsApplied << ",\n  \"live_edits_missed\": " << editsMissed
-             << ",\n  \"ok\": " << (status == 0 ? "true" : "false") << "\n}\n";
-        std::printf("wrote %s/soak.json\n", outDir.c_str());
+    o.width = options->width, o.height = options->height;
+    copy.pointAt(o);
+    app::App app;
+    if (!app.init(o, error)) {
+        std::fprintf(stderr, "kiln-soak: error: %s\n", error.c_str());
+        return 1;
     }
-    fs::remove_all(root);
-    return status;
+    Soak soak(app, *options, files);
+    soak.run();
+    const std::vector<std::string> problems = soak.problems();
+    soak.printTable();
+    for (auto& p : problems) std::printf("kiln-soak: FAIL: %s\n", p.c_str());
+    if (problems.empty()) std::printf("kiln-soak: ok\n");
+    std::error_code ec;
+    fs::create_directories(options->outDir, ec);
+    soak.writeJson(fs::path(options->outDir) / "soak.json", problems.empty());
+    std::printf("wrote %s/soak.json\n", options->outDir.c_str());
+    return problems.empty() ? 0 : 1;
 }

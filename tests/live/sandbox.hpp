@@ -15,6 +15,7 @@
 #include <thread>
 
 #include "app/app.hpp"
+#include "app/editable_copy.hpp"
 #include "kiln/image_io.hpp"
 #include "support/headless.hpp"
 
@@ -22,37 +23,20 @@ namespace kiln::test {
 
 namespace fs = std::filesystem;
 
-inline std::string slurp(const fs::path& p) {
-    std::ifstream in(p);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
+inline std::string slurp(const fs::path& p) { return app::readWholeFile(p); }
 inline void writeInPlace(const fs::path& p, const std::string& text) { std::ofstream(p, std::ios::trunc) << text; }
-
-// An editor's save: write a temporary file next to it, then rename over it.
-inline void writeByRename(const fs::path& p, const std::string& text) {
-    const fs::path tmp = p.parent_path() / ("." + p.filename().string() + ".new");
-    std::ofstream(tmp, std::ios::trunc) << text;
-    fs::rename(tmp, p);
-}
+inline void writeByRename(const fs::path& p, const std::string& text) { app::saveByRename(p, text); }
 
 struct Sandbox {
+    app::EditableCopy copy;
     fs::path root;
     app::App app;
 
     // `prepare` runs on the copied tree before the app starts (e.g. installs a module).
     explicit Sandbox(const std::string& name, const std::string& pipeline = "default.json",
-                     const std::string& pipelineText = {}, std::function<void(const fs::path&)> prepare = {}) {
+                     const std::string& pipelineText = {}, std::function<void(const fs::path&)> prepare = {})
+        : copy(fs::path(TEST_OUTPUT_DIR) / (name + "-" + std::to_string(getpid())), KILN_SOURCE_DIR), root(copy.root()) {
         REQUIRE(test::ensureHeadlessContext());
-        root = fs::path(TEST_OUTPUT_DIR) / (name + "-" + std::to_string(getpid()));
-        fs::remove_all(root);
-        fs::create_directories(root / "modules");
-        fs::create_directories(root / "scenes");
-        fs::copy(fs::path(KILN_SOURCE_DIR) / "shaders", root / "shaders", fs::copy_options::recursive);
-        fs::copy(fs::path(KILN_SOURCE_DIR) / "pipelines", root / "pipelines", fs::copy_options::recursive);
-        fs::copy_file(fs::path(KILN_SOURCE_DIR) / "scenes/cornell.json", root / "scenes/cornell.json");
         if (!pipelineText.empty()) writeInPlace(root / "pipelines" / pipeline, pipelineText);
         if (prepare) prepare(root);
         app::Options o;
@@ -60,17 +44,10 @@ struct Sandbox {
         o.headless = true;
         o.width = o.height = 32;
         o.paused = true;
-        o.shaderRoot = (root / "shaders").string();
-        o.pipeline = (root / "pipelines" / pipeline).string();
-        o.scene = (root / "scenes/cornell.json").string();
-        o.moduleDir = (root / "modules").string() + ":" + o.moduleDir;
+        copy.pointAt(o, pipeline);
         std::string error;
         REQUIRE(app.init(o, error));
         app.frame();
-    }
-    ~Sandbox() {
-        std::error_code ec;
-        fs::remove_all(root, ec);
     }
 
     // Renders frames until `done` holds; false after 30 s (a generous bound: CI machines
