@@ -10,7 +10,9 @@
 //   values and everything that must survive a reload of the module.
 //
 // WRITING ONE (passes/<name>/, two files; the next `cmake --build build` finds the new
-// folder and re-runs CMake by itself)
+// folder and re-runs CMake by itself). The example below is shipped as it stands
+// (passes/tint/, shaders/tint/tint.frag): tests/integration/test_manual.cpp checks that
+// this text and those files are the same, then renders with the pass and checks it tints.
 //   passes/<name>/CMakeLists.txt:   kiln_add_pass(<name> <name>.cpp)
 //   passes/<name>/<name>.cpp:
 //
@@ -104,8 +106,15 @@
 //   texture units 0–15 and image units 0–7 unbound; the frame uniform block and the
 //   scene's instance buffer (common/instances.glsl, SSBO binding 0) bound, so a compute
 //   pass can read the scene too (SceneView::firstInstance says where a category starts).
-//   Anything else you change (clip control, point size, SSBO bindings other than 0,
-//   memory barriers) is yours to restore or to set every time.
+//   Anything else you change (clip control, point size, SSBO bindings other than 0)
+//   is yours to restore or to set every time.
+//
+// MEMORY BARRIERS
+//   Between passes they are the host's: after your execute() returns, the host issues
+//   one glMemoryBarrier covering every way a later pass can read what you wrote
+//   (texture fetches, image loads, attachments, copies, read-backs), so a producer does
+//   not barrier for its consumers. Between your own dispatches and draws inside one
+//   execute() (a compute pass writing an image a second dispatch reads) they are yours.
 //
 // RULES THAT KEEP RELOADING SAFE (see "Live editing" in the README)
 //   Set every uniform in each execute(): a shader edit swaps in a new program and no
@@ -129,8 +138,10 @@
 
 namespace kiln {
 
-// Bump when anything in this header (or what it includes) changes layout or vtables.
-inline constexpr uint32_t kPassAbiVersion = 5;
+// Bump when anything in this header (or what it includes) changes layout or vtables,
+// or when what the host does for a pass changes (6: the host issues the barrier
+// between passes), so a module built for other terms is refused by name, not run.
+inline constexpr uint32_t kPassAbiVersion = 6;
 
 struct TextureRef {
     GLuint id = 0;
