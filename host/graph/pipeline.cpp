@@ -95,54 +95,6 @@ ParamLiteral toLiteral(const Json& j) {
 }
 
 
-// nlohmann silently keeps the last of two equal keys; a second "params" block that
-// wins over the first is a nasty surprise, so the parse callback reports it.
-class DuplicateKeyFinder {
-public:
-    explicit DuplicateKeyFinder(std::vector<std::string>& paths) : paths_(paths) {}
-
-    bool operator()(int /*depth*/, nlohmann::detail::parse_event_t event, Json& parsed) {
-        using E = nlohmann::detail::parse_event_t;
-        switch (event) {
-            case E::object_start: frames_.push_back({false, 0, {}, {}}); break;
-            case E::array_start: frames_.push_back({true, 0, {}, {}}); break;
-            case E::key: {
-                Frame& f = frames_.back();
-                f.key = parsed.is_string() ? parsed.get<std::string>() : std::string();
-                if (!f.keys.insert(f.key).second) paths_.push_back(currentPath());
-                break;
-            }
-            case E::object_end:
-            case E::array_end:
-                if (!frames_.empty()) frames_.pop_back();
-                finishValue();
-                break;
-            case E::value: finishValue(); break;
-        }
-        return true;
-    }
-
-private:
-    struct Frame {
-        bool array;
-        size_t index;
-        std::string key;
-        std::set<std::string> keys;
-    };
-
-    void finishValue() {
-        if (!frames_.empty() && frames_.back().array) ++frames_.back().index;
-    }
-
-    std::string currentPath() const {
-        std::string p;
-        for (const Frame& f : frames_) p = f.array ? indexPath(p, f.index) : keyPath(p, f.key);
-        return p;
-    }
-
-    std::vector<std::string>& paths_;
-    std::vector<Frame> frames_;
-};
 
 class Reader {
 public:
@@ -356,18 +308,6 @@ std::string collapseFlatArrays(const std::string& text) {
 
 }  // namespace
 
-std::string keyPath(const std::string& parent, const std::string& key) {
-    bool plain = !key.empty();
-    for (char c : key)
-        if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '$')) plain = false;
-    if (!plain) return parent + "[" + elide(Json(key).dump()) + "]";
-    return parent.empty() ? key : parent + "." + key;
-}
-
-std::string indexPath(const std::string& parent, size_t i) {
-    return parent + "[" + std::to_string(i) + "]";
-}
-
 Json toJson(const ParamLiteral& l) {
     switch (l.type) {
         case ParamLiteral::Type::Bool: return l.b;
@@ -419,8 +359,11 @@ Result<PipelineDesc> parsePipeline(const std::string& text, const std::string& f
     Json root;
     if (auto deep = tooDeep(text, fileName)) return Result<PipelineDesc>(std::move(*deep));
     try {
-        DuplicateKeyFinder finder(duplicates);
-        root = Json::parse(text, std::ref(finder), /*allow_exceptions=*/true, /*ignore_comments=*/false);
+        // nlohmann silently keeps the last of two equal keys; a second "params" block
+        // that wins over the first is a nasty surprise, so the tracker notes them.
+        json_text::PathTracker tracker;
+        root = Json::parse(text, std::ref(tracker), /*allow_exceptions=*/true, /*ignore_comments=*/false);
+        duplicates = tracker.duplicateKeys();
     } catch (const Json::parse_error& e) {
         Diagnostic d;
         d.file = fileName;

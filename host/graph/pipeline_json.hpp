@@ -8,6 +8,7 @@
 #include <string>
 
 #include "graph/pipeline.hpp"
+#include "kiln/json_path.hpp"
 
 namespace kiln::graph {
 
@@ -17,11 +18,9 @@ using Json = nlohmann::ordered_json;  // keeps the file's key order (params, inp
 // everything that walks the parsed value, and the size of every message about it.
 inline constexpr int kMaxNesting = 32;
 
-// JSON path of a key under `parent`: "passes[2].params.size"; keys that are not plain
-// identifiers are bracketed: params["my key"].
-std::string keyPath(const std::string& parent, const std::string& key);
-// "passes[2]".
-std::string indexPath(const std::string& parent, size_t i);
+// JSON paths for messages: "passes[2].params.size", params["my key"] (common/).
+using json_text::indexPath;
+using json_text::keyPath;
 // An object literal is kept as its text; one that is not JSON comes back discarded.
 Json toJson(const ParamLiteral& l);
 

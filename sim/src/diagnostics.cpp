@@ -86,4 +86,17 @@ double World::maxContainmentViolation() const {
     for (auto& b : balls_) check(b.position, b.radius);
     return worst;
 }
+
+double World::deepestTumblerOverlap() const {
+    double worst = 0.0;
+    for (size_t a = 0; a < tumblers_.size(); ++a)
+        for (size_t b = a + 1; b < tumblers_.size(); ++b) {
+            const Tumbler& ta = tumblers_[a];
+            const Tumbler& tb = tumblers_[b];
+            worst = std::min(worst, roundConeSeparation(ta.position, ta.upperCentre(shape_), shape_.b(), shape_.t(),
+                                                        tb.position, tb.upperCentre(shape_), shape_.b(), shape_.t())
+                                        .distance);
+        }
+    return worst;
+}
 }  // namespace kiln::sim

@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "kiln/json_path.hpp"
 #include "kiln/json_text.hpp"
 #include "kiln/sim/shape.hpp"
 
@@ -184,43 +185,6 @@ bool restitution(const Json& physics, Scene::Physics::Restitution& e, SceneError
 
 using json_text::lineColumn;
 
-// Follows the parse to know the JSON path of the value being read when the library
-// refuses one (a number beyond double range): "physics.dt", "marbles[3].position[1]".
-class PathTracker {
-public:
-    bool operator()(int /*depth*/, nlohmann::detail::parse_event_t event, Json& parsed) {
-        using E = nlohmann::detail::parse_event_t;
-        switch (event) {
-            case E::object_start: frames_.push_back({false, 0, {}}); break;
-            case E::array_start: frames_.push_back({true, 0, {}}); break;
-            case E::key: if (!frames_.empty()) frames_.back().key = parsed.is_string() ? parsed.get<std::string>() : ""; break;
-            case E::object_end:
-            case E::array_end:
-                if (!frames_.empty()) frames_.pop_back();
-                finishValue();
-                break;
-            case E::value: finishValue(); break;
-        }
-        return true;
-    }
-    std::string path() const {
-        std::string p;
-        for (const Frame& f : frames_)
-            p = f.array ? p + "[" + std::to_string(f.index) + "]" : (p.empty() ? json_text::elide(f.key, 60) : p + "." + json_text::elide(f.key, 60));
-        return p;
-    }
-
-private:
-    struct Frame {
-        bool array;
-        size_t index;
-        std::string key;
-    };
-    void finishValue() {
-        if (!frames_.empty() && frames_.back().array) ++frames_.back().index;
-    }
-    std::vector<Frame> frames_;
-};
 
 // Parses the JSON text; a syntax error becomes "line L, column C: ...". Every exception
 // the JSON library throws (syntax, a number beyond double range, ...) becomes an error
@@ -233,7 +197,9 @@ bool parseJson(const std::string& text, Json& root, SceneError& error) {
                          std::to_string(kMaxSceneNesting) + " levels"};
         return false;
     }
-    PathTracker tracker;
+    // Where the parser was when the library refused a value (a number beyond double
+    // range): "physics.dt", "marbles[3].position[1]".
+    json_text::PathTracker tracker;
     try {
         root = Json::parse(text, std::ref(tracker));
     } catch (const Json::parse_error& e) {
@@ -268,6 +234,12 @@ bool parseJson(const std::string& text, Json& root, SceneError& error) {
     }
     if (!root.is_object()) {
         error = {"", std::string("the scene must be a JSON object, got ") + typeName(root)};
+        return false;
+    }
+    // nlohmann keeps the last of two equal keys: a second "physics" block would silently
+    // win over the first.
+    if (!tracker.duplicateKeys().empty()) {
+        error = {tracker.duplicateKeys().front(), "duplicate key: only the last one would count"};
         return false;
     }
     return true;

@@ -263,20 +263,6 @@ bool benchContactPoses(const Scene& scene, const Out& out, bool quick) {
     return true;
 }
 
-double deepestOverlap(const World& w) {
-    double worst = 0.0;
-    const RoundCone& sh = w.shape();
-    for (size_t a = 0; a < w.tumblers().size(); ++a)
-        for (size_t b = a + 1; b < w.tumblers().size(); ++b) {
-            const Tumbler& ta = w.tumblers()[a];
-            const Tumbler& tb = w.tumblers()[b];
-            worst = std::min(worst, roundConeSeparation(ta.position, ta.upperCentre(sh), sh.b(), sh.t(), tb.position,
-                                                        tb.upperCentre(sh), sh.b(), sh.t())
-                                        .distance);
-        }
-    return worst;
-}
-
 bool benchContactScene(const Scene& scene, const Out& out, bool quick) {
     // The scene with 25 more marbles and 4 fireballs, each tumbler contact method: cost,
     // the deepest tumbler overlap seen after a frame (by the exact separation) and the
@@ -302,7 +288,7 @@ bool benchContactScene(const Scene& scene, const Out& out, bool quick) {
             const auto t0 = Clock::now();
             w.step();
             stepping += seconds(t0), ++frames;
-            overlap = std::min(overlap, deepestOverlap(w));
+            overlap = std::min(overlap, w.deepestTumblerOverlap());
             drift = std::max(drift, std::abs(w.totalEnergy() + w.removedBallEnergy() - e0) / ke);
         }
         const char* name = method == TumblerContact::Exact ? "exact" : "four_spheres";

@@ -16,20 +16,6 @@ using namespace kiln::sim::test;
 
 namespace {
 
-double deepestTumblerOverlap(const World& w) {
-    double worst = 0.0;
-    const RoundCone& sh = w.shape();
-    for (size_t a = 0; a < w.tumblers().size(); ++a)
-        for (size_t b = a + 1; b < w.tumblers().size(); ++b) {
-            const Tumbler& ta = w.tumblers()[a];
-            const Tumbler& tb = w.tumblers()[b];
-            worst = std::min(worst, roundConeSeparation(ta.position, ta.upperCentre(sh), sh.b(), sh.t(), tb.position,
-                                                        tb.upperCentre(sh), sh.b(), sh.t())
-                                        .distance);
-        }
-    return worst;
-}
-
 // Smallest SDF of any ball centre against any tumbler (negative: a centre inside).
 double ballCentreClearance(const World& w) {
     double worst = 1e9;
@@ -178,7 +164,7 @@ TEST_CASE("containment at every dt from 1/1000 to 1/15 s and any sub-step count"
             for (int f = 0; f < frames; ++f) {
                 w.step();
                 out = std::max(out, w.maxContainmentViolation());
-                overlap = std::min(overlap, deepestTumblerOverlap(w));
+                overlap = std::min(overlap, w.deepestTumblerOverlap());
                 clearance = std::min(clearance, ballCentreClearance(w));
             }
             INFO("dt 1/" << inv << " x" << sub << ": out " << out << " m, tumbler overlap " << overlap

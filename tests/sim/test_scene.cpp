@@ -66,6 +66,10 @@ TEST_CASE("bad scene files give the JSON path and what is wrong", "[sim][scene]"
     CHECK(errorOf(R"({"tumblers": [], "marbles": [{"position": [0, 0.99, 0]}]})") ==
           "scenes/x.json: marbles[0].position: the ball (radius 0.05) does not fit inside the box [-1,1]^3");
     CHECK(errorOf(R"({"tumblers": [], "lamp": {"radius": 0.3, "colour": [1,1,1]}})") == "scenes/x.json: lamp.colour: unknown key");
+    CHECK(errorOf(R"({"tumblers": [], "physics": {"dt": 0.01}, "marbles": [], "physics": {"dt": 0.02}})") ==
+          "scenes/x.json: physics: duplicate key: only the last one would count");
+    CHECK(errorOf(R"({"tumblers": [{"position": [0, 0], "position": [0.1, 0]}]})") ==
+          "scenes/x.json: tumblers[0].position: duplicate key: only the last one would count");
     CHECK(errorOf(R"({"tumblers": [], "tumbler_shape": {"b": 0.1, "t": 0.2}})") ==
           "scenes/x.json: tumbler_shape.t: must be smaller than b (the upper sphere sits on the lower one)");
     CHECK(errorOf(R"({"tumblers": {}})") == "scenes/x.json: tumblers: expected an array, got an object");

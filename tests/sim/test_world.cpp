@@ -409,12 +409,7 @@ TEST_CASE("tumbler against tumbler: both methods push them apart", "[sim][world]
         double worst = 0;
         for (int i = 0; i < 480; ++i) {
             w.step();
-            const auto& a = w.tumblers()[0];
-            const auto& b = w.tumblers()[1];
-            const double sep = roundConeSeparation(a.position, a.upperCentre(w.shape()), 0.2, 0.1, b.position,
-                                                   b.upperCentre(w.shape()), 0.2, 0.1)
-                                   .distance;
-            worst = std::min(worst, sep);
+            worst = std::min(worst, w.deepestTumblerOverlap());
         }
         INFO((method == TumblerContact::Exact ? "exact" : "four spheres") << ": deepest overlap after a step " << worst);
         REQUIRE(w.allFinite());

@@ -230,6 +230,8 @@ public:
     double maxQuaternionError() const;  // max | |q| − 1 |
     bool allFinite() const;
     double maxContainmentViolation() const;  // how far any sphere pokes out of the box
+    // The most negative exact separation of any two tumblers (0 when none overlap).
+    double deepestTumblerOverlap() const;
 
 private:
     void substep(double dt);
