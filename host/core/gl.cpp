@@ -54,6 +54,46 @@ DebugGroup::~DebugGroup() {
     if (glPopDebugGroup) glPopDebugGroup();
 }
 
+namespace {
+// The unit a sampler or image uniform was given by layout(binding = N); -1 if inactive.
+GLint unitOf(GLuint program, const char* name) {
+    const GLint location = glGetUniformLocation(program, name);
+    if (location < 0) return -1;
+    GLint unit = -1;
+    glGetUniformiv(program, location, &unit);
+    return unit;
+}
+}  // namespace
+
+bool bindTexture(GLuint program, const char* sampler, GLuint texture) {
+    const GLint unit = unitOf(program, sampler);
+    if (unit >= 0) glBindTextureUnit(GLuint(unit), texture);
+    return unit >= 0;
+}
+
+bool bindSamplerObject(GLuint program, const char* sampler, GLuint samplerObject) {
+    const GLint unit = unitOf(program, sampler);
+    if (unit >= 0) glBindSampler(GLuint(unit), samplerObject);
+    return unit >= 0;
+}
+
+bool bindImage(GLuint program, const char* image, GLuint texture, GLint level, bool layered, GLenum access,
+               GLenum format) {
+    const GLint unit = unitOf(program, image);
+    if (unit >= 0) glBindImageTexture(GLuint(unit), texture, level, layered ? GL_TRUE : GL_FALSE, 0, access, format);
+    return unit >= 0;
+}
+
+bool bindStorageBuffer(GLuint program, const char* block, GLuint buffer) {
+    const GLuint index = glGetProgramResourceIndex(program, GL_SHADER_STORAGE_BLOCK, block);
+    if (index == GL_INVALID_INDEX) return false;
+    const GLenum property = GL_BUFFER_BINDING;
+    GLint binding = -1;
+    glGetProgramResourceiv(program, GL_SHADER_STORAGE_BLOCK, index, 1, &property, 1, nullptr, &binding);
+    if (binding >= 0) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, GLuint(binding), buffer);
+    return binding >= 0;
+}
+
 namespace detail {
 void deleteTexture(GLuint id) { glDeleteTextures(1, &id); }
 void deleteBuffer(GLuint id) { glDeleteBuffers(1, &id); }

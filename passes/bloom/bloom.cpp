@@ -58,9 +58,9 @@ public:
         glNamedBufferSubData(anyBright_.id(), 0, 4, &zero);
         glUseProgram(brightPass);
         glUniform1f(glGetUniformLocation(brightPass, "u_threshold"), threshold);
-        glBindTextureUnit(0, in.id);
-        glBindImageTexture(0, bright.id, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA16F);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, anyBright_.id());
+        kiln::gl::bindTexture(brightPass, "u_color", in.id);
+        kiln::gl::bindImage(brightPass, "u_bright", bright.id, 0, false, GL_WRITE_ONLY, GL_RGBA16F);
+        kiln::gl::bindStorageBuffer(brightPass, "AnyBright", anyBright_.id());
         glDispatchCompute(GLuint((bright.width + 7) / 8), GLuint((bright.height + 7) / 8), 1);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
 
@@ -71,12 +71,13 @@ public:
         if (!ctx.framebuffer({"ping"})) return;
         glUniform2f(glGetUniformLocation(blur, "u_direction"), 1.0f, 0.0f);
         glUniform1f(glGetUniformLocation(blur, "u_gain"), 1.0f);
-        glBindTextureUnit(0, bright.id);
+        kiln::gl::bindStorageBuffer(blur, "AnyBright", anyBright_.id());
+        kiln::gl::bindTexture(blur, "u_src", bright.id);
         ctx.drawFullscreenTriangle();
         if (!ctx.framebuffer({"bloom"})) return;
         glUniform2f(glGetUniformLocation(blur, "u_direction"), 0.0f, 1.0f);
         glUniform1f(glGetUniformLocation(blur, "u_gain"), ctx.getFloat("intensity"));
-        glBindTextureUnit(0, ctx.internal("ping").id);
+        kiln::gl::bindTexture(blur, "u_src", ctx.internal("ping").id);
         ctx.drawFullscreenTriangle();
     }
 

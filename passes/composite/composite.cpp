@@ -71,8 +71,6 @@ public:
             return ctx.fail("lamp_model traced reads the lamp from `indirect` (cone_trace.indirect with cone_trace's "
                             "`lamp` on): bind it, or use lamp_model contour");
         if (!ctx.framebuffer({"color", "hdr"})) return;
-        const char* inputs[] = {"albedo", "normal", "depth", "emissive", "shadow_map", "indirect", "bloom"};
-        for (GLuint unit = 0; unit < 7; ++unit) glBindTextureUnit(unit, ctx.input(inputs[unit]).id);
         // The shadow map is read through hardware comparison (sampler2DShadow): each
         // lookup a bilinear blend of four depth tests. A sampler object, so the shadow
         // pass's texture keeps its own state for the passes that read raw depth.
@@ -85,7 +83,6 @@ public:
             glSamplerParameteri(compareSampler_.id(), GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
             glSamplerParameteri(compareSampler_.id(), GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
         }
-        glBindSampler(4, compareSampler_.id());
         draw(ctx, program);
         // The near field again, per pixel, over its screen rectangle only.
         if (nearField) {
@@ -98,12 +95,18 @@ public:
                 glDisable(GL_SCISSOR_TEST);
             }
         }
-        glBindSampler(4, 0);
+        kiln::gl::bindSamplerObject(program, "u_shadowMap", 0);  // the host resets textures, not samplers
     }
 
 private:
-    static void draw(kiln::PassContext& ctx, GLuint program) {
+    void draw(kiln::PassContext& ctx, GLuint program) const {
         glUseProgram(program);
+        // Each input to the sampler of its name (u_shadow_map is u_shadowMap).
+        for (auto [slot, sampler] : {std::pair{"albedo", "u_albedo"}, {"normal", "u_normal"}, {"depth", "u_depth"},
+                                     {"emissive", "u_emissive"}, {"shadow_map", "u_shadowMap"},
+                                     {"indirect", "u_indirect"}, {"bloom", "u_bloom"}})
+            kiln::gl::bindTexture(program, sampler, ctx.input(slot).id);
+        kiln::gl::bindSamplerObject(program, "u_shadowMap", compareSampler_.id());
         const std::string& tonemap = ctx.getEnum("tonemap");
         glUniform1f(glGetUniformLocation(program, "u_exposure"), ctx.getFloat("exposure"));
         glUniform1f(glGetUniformLocation(program, "u_ambient"), ctx.getFloat("ambient"));

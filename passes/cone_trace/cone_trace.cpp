@@ -183,14 +183,13 @@ public:
         const bool upsampled = stride > divisor;
         const int traceStep = upsampled ? stride : divisor;
 
-        glBindTextureUnit(0, ctx.input("normal").id);
-        glBindTextureUnit(1, ctx.input("depth").id);
-        glBindTextureUnit(2, voxels.id);
-        glBindTextureUnit(3, ctx.input("aniso").id);
-        glBindTextureUnit(6, ctx.input("fixed_cones").id);
-
         if (!(upsampled ? ctx.framebuffer({"samples", "planes"}) : ctx.framebuffer({"indirect"}))) return;
         glUseProgram(trace);
+        kiln::gl::bindTexture(trace, "u_normal", ctx.input("normal").id);
+        kiln::gl::bindTexture(trace, "u_depth", ctx.input("depth").id);
+        kiln::gl::bindTexture(trace, "u_voxels", voxels.id);
+        kiln::gl::bindTexture(trace, "u_aniso", ctx.input("aniso").id);
+        kiln::gl::bindTexture(trace, "u_fixedCones", ctx.input("fixed_cones").id);
         auto loc = [&](const char* n) { return glGetUniformLocation(trace, n); };
         if (!ctx.isBound("fixed_cones")) {  // the fixed set is the shader's own
             const std::vector<float> cones = coneSet(ctx.getInt("cones"));
@@ -206,8 +205,10 @@ public:
         if (upsampled) {
             if (!ctx.framebuffer({"indirect"})) return;
             glUseProgram(upsample);
-            glBindTextureUnit(4, ctx.internal("samples").id);
-            glBindTextureUnit(5, ctx.internal("planes").id);
+            kiln::gl::bindTexture(upsample, "u_normal", ctx.input("normal").id);
+            kiln::gl::bindTexture(upsample, "u_depth", ctx.input("depth").id);
+            kiln::gl::bindTexture(upsample, "u_samples", ctx.internal("samples").id);
+            kiln::gl::bindTexture(upsample, "u_planes", ctx.internal("planes").id);
             glUniform1i(glGetUniformLocation(upsample, "u_stride"), stride);
             glUniform1i(glGetUniformLocation(upsample, "u_outputStep"), divisor);
             glUniform1f(glGetUniformLocation(upsample, "u_planeTolerance"), ctx.getFloat("upsample_tolerance"));

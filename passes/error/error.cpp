@@ -27,8 +27,8 @@ public:
         GLuint program = ctx.program({.stages = {"common/fullscreen.vert", "error/error.frag"}});
         if (!program || !ctx.framebuffer({"color"})) return;
         glUseProgram(program);
-        glBindTextureUnit(0, ctx.input("image").id);
-        glBindTextureUnit(1, ctx.input("reference").id);
+        kiln::gl::bindTexture(program, "u_image", ctx.input("image").id);
+        kiln::gl::bindTexture(program, "u_reference", ctx.input("reference").id);
         const std::string& mode = ctx.getEnum("mode");
         glUniform1i(glGetUniformLocation(program, "u_mode"), mode == "relative" ? 0 : mode == "signed" ? 1 : 2);
         glUniform1f(glGetUniformLocation(program, "u_scale"), ctx.getFloat("scale"));

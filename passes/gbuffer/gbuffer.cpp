@@ -40,7 +40,7 @@ public:
         const auto& f = ctx.scene().frame;
         if (wood.id != bakedTexture_ || f.woodLight != bakedLight_ || f.woodDark != bakedDark_ || bake != bakedWith_) {
             glUseProgram(bake);
-            glBindImageTexture(0, wood.id, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA8);
+            kiln::gl::bindImage(bake, "u_wood", wood.id, 0, false, GL_WRITE_ONLY, GL_RGBA8);
             glDispatchCompute(GLuint((wood.width + 7) / 8), GLuint((wood.height + 7) / 8), 1);
             glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
             glGenerateTextureMipmap(wood.id);
@@ -53,7 +53,7 @@ public:
         glEnable(GL_DEPTH_TEST);
         glDepthFunc(GL_LESS);
         glUseProgram(program);
-        glBindTextureUnit(1, wood.id);
+        kiln::gl::bindTexture(program, "u_wood", wood.id);
         kiln::DrawFilter filter;
         filter.categories = kiln::kSceneGeometry;
         if (!particles || points) filter.categories &= ~kiln::kSceneParticles;

@@ -68,8 +68,8 @@ public:
         glUniform1i(glGetUniformLocation(program, "u_maxBounces"), ctx.getInt("max_bounces"));
         glUniform1i(glGetUniformLocation(program, "u_rouletteStart"), ctx.getInt("roulette_start"));
         glUniform1i(glGetUniformLocation(program, "u_jitter"), ctx.getBool("jitter") ? 1 : 0);
-        glBindImageTexture(0, radiance.id, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
-        glBindImageTexture(1, direct.id, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+        kiln::gl::bindImage(program, "u_radiance", radiance.id, 0, false, GL_READ_WRITE, GL_RGBA32F);
+        kiln::gl::bindImage(program, "u_direct", direct.id, 0, false, GL_READ_WRITE, GL_RGBA32F);
         // A few paths per dispatch: llvmpipe silently ends a shader loop after 65 535
         // iterations (counted across the nesting), which dropped every path beyond
         // ~215 in one invocation here; 8 per dispatch stays far below.
@@ -80,8 +80,6 @@ public:
             glDispatchCompute(GLuint((radiance.width + 7) / 8), GLuint((radiance.height + 7) / 8), 1);
             glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
         }
-        glBindImageTexture(0, 0, 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
-        glBindImageTexture(1, 0, 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
         samples_ += batch;
     }
 

@@ -11,7 +11,7 @@ class Tint final : public kiln::Pass {
     GLuint prog = ctx.program({.stages = {"common/fullscreen.vert", "tint/tint.frag"}});
     if (!prog || !ctx.framebuffer({"color"})) return;  // the host shows the error
     glUseProgram(prog);
-    glBindTextureUnit(0, ctx.input("color").id);      // layout(binding = 0) in the shader
+    kiln::gl::bindTexture(prog, "u_color", ctx.input("color").id);  // the shader's unit
     auto t = ctx.getColor("tint");
     glUniform3f(glGetUniformLocation(prog, "u_tint"), t[0], t[1], t[2]);
     ctx.drawFullscreenTriangle();

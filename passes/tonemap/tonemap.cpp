@@ -23,8 +23,8 @@ public:
         GLuint program = ctx.program({.stages = {"common/fullscreen.vert", "tonemap/tonemap.frag"}});
         if (!program || !ctx.framebuffer({"color"})) return;
         glUseProgram(program);
-        glBindTextureUnit(0, ctx.input("hdr").id);
-        glBindTextureUnit(1, ctx.input("bloom").id);
+        kiln::gl::bindTexture(program, "u_hdr", ctx.input("hdr").id);
+        kiln::gl::bindTexture(program, "u_bloom", ctx.input("bloom").id);
         const std::string& curve = ctx.getEnum("tonemap");
         glUniform1f(glGetUniformLocation(program, "u_exposure"), ctx.getFloat("exposure"));
         glUniform1f(glGetUniformLocation(program, "u_gamma"), ctx.getFloat("gamma"));

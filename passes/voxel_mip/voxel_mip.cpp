@@ -141,21 +141,19 @@ public:
             glUniform1f(glGetUniformLocation(bounce, "u_voxelRes"), float(res));
             glUniform1f(glGetUniformLocation(bounce, "u_startOffset"), ctx.getFloat("gather_start_offset"));
             glUniform1f(glGetUniformLocation(bounce, "u_diameterOffset"), ctx.getFloat("gather_diameter_offset"));
-            glBindTextureUnit(0, in.id);
-            glBindTextureUnit(1, ctx.input("albedo").id);
-            glBindTextureUnit(4, ctx.input("normal").id);
-            glBindTextureUnit(2, chain.id);
-            glBindTextureUnit(3, ctx.output("aniso").id);
-            glBindTextureUnit(6, ctx.output("fixed_cones").id);
-            glBindImageTexture(0, bounced.id, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA16F);
+            kiln::gl::bindTexture(bounce, "u_emitted", in.id);
+            kiln::gl::bindTexture(bounce, "u_albedo", ctx.input("albedo").id);
+            kiln::gl::bindTexture(bounce, "u_normal", ctx.input("normal").id);
+            kiln::gl::bindTexture(bounce, "u_voxels", chain.id);
+            kiln::gl::bindTexture(bounce, "u_aniso", ctx.output("aniso").id);
+            kiln::gl::bindTexture(bounce, "u_fixedCones", ctx.output("fixed_cones").id);
+            kiln::gl::bindImage(bounce, "u_bounced", bounced.id, 0, true, GL_WRITE_ONLY, GL_RGBA16F);
             const int blocks = res / ctx.getInt("gather_block");
             glDispatchCompute(groups(blocks), groups(blocks), groups(blocks));
             glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
             glCopyImageSubData(bounced.id, GL_TEXTURE_3D, 0, 0, 0, 0, chain.id, GL_TEXTURE_3D, 0, 0, 0, 0, res, res, res);
             buildChains(ctx, iso, aniso, blend);
         }
-        glBindImageTexture(0, 0, 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA16F);
-        glBindImageTexture(1, 0, 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA16F);
     }
 
 private:
@@ -172,8 +170,8 @@ private:
         for (int level = 1; level < chain.levels; ++level) {
             const int n = std::max(1, res >> level);
             glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
-            glBindImageTexture(0, chain.id, level - 1, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA16F);
-            glBindImageTexture(1, chain.id, level, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA16F);
+            kiln::gl::bindImage(iso, "u_src", chain.id, level - 1, true, GL_READ_ONLY, GL_RGBA16F);
+            kiln::gl::bindImage(iso, "u_dst", chain.id, level, true, GL_WRITE_ONLY, GL_RGBA16F);
             glDispatchCompute(groups(n), groups(n), groups(n));
         }
 
@@ -184,10 +182,10 @@ private:
                 const int n = res >> L;
                 glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
                 if (L == 1)
-                    glBindImageTexture(0, chain.id, 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA16F);
+                    kiln::gl::bindImage(aniso, "u_src", chain.id, 0, true, GL_READ_ONLY, GL_RGBA16F);
                 else
-                    glBindImageTexture(0, atlas.id, L - 2, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA16F);
-                glBindImageTexture(1, atlas.id, L - 1, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA16F);
+                    kiln::gl::bindImage(aniso, "u_src", atlas.id, L - 2, true, GL_READ_ONLY, GL_RGBA16F);
+                kiln::gl::bindImage(aniso, "u_dst", atlas.id, L - 1, true, GL_WRITE_ONLY, GL_RGBA16F);
                 glUniform1i(glGetUniformLocation(aniso, "u_fromBase"), L == 1 ? 1 : 0);
                 glUniform1i(glGetUniformLocation(aniso, "u_size"), n);
                 glDispatchCompute(groups(n), groups(n), groups(n));
@@ -203,8 +201,8 @@ private:
             for (int L = 1; (res >> L) >= 1; ++L) {
                 const int n = res >> L;
                 glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
-                glBindImageTexture(0, atlas.id, L - 1, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA16F);
-                glBindImageTexture(1, fixed.id, L - 1, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA16F);
+                kiln::gl::bindImage(blend, "u_aniso", atlas.id, L - 1, true, GL_READ_ONLY, GL_RGBA16F);
+                kiln::gl::bindImage(blend, "u_fixed", fixed.id, L - 1, true, GL_WRITE_ONLY, GL_RGBA16F);
                 glUniform1i(glGetUniformLocation(blend, "u_size"), n);
                 glDispatchCompute(groups(n), groups(n), groups(n));
             }

@@ -25,7 +25,7 @@ public:
         if (!prog || !ctx.framebuffer({"color"})) return;
         const kiln::TextureRef& v = ctx.input("voxels");
         glUseProgram(prog);
-        glBindTextureUnit(0, v.id);
+        kiln::gl::bindTexture(prog, "u_voxels", v.id);
         glUniform1i(glGetUniformLocation(prog, "u_mip"), std::min(ctx.getInt("mip"), v.levels - 1));
         glUniform1f(glGetUniformLocation(prog, "u_exposure"), ctx.getFloat("exposure"));
         glUniform1f(glGetUniformLocation(prog, "u_minOpacity"), ctx.getFloat("min_opacity"));

@@ -66,8 +66,8 @@ public:
                      .doc = "rgb = the surfaces' mean albedo (particles count as 0), a = occupancy"})
             .output({.name = "normal", .kind = TextureKind::Color3D, .format = Format::RGBA16F, .size = cube,
                      .doc = "xyz = the surfaces' mean unit normal (shorter where they disagree), a = occupancy"});
-        for (const char* sum : kSums)
-            d.internal({.name = sum, .kind = TextureKind::Color3D, .format = Format::R32UI, .size = cube});
+        for (const Sum& sum : kSums)
+            d.internal({.name = sum.internal, .kind = TextureKind::Color3D, .format = Format::R32UI, .size = cube});
         d.param(intChoiceParam("resolution", 64, {32, 64, 128}, "voxels per side over [-1,1]^3"))
             .param(boolParam("conservative", true, "enlarge triangles by half a voxel (no holes from thin triangles)"))
             .param(boolParam("marbles", false, "voxelize the marbles too (the course design leaves them out)"))
@@ -107,7 +107,7 @@ public:
         const kiln::TextureRef& out = ctx.output("radiance");
         const int res = out.width;
 
-        for (const char* sum : kSums) glClearTexImage(ctx.internal(sum).id, 0, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
+        for (const Sum& sum : kSums) glClearTexImage(ctx.internal(sum.internal).id, 0, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
 
         // 1–3: rasterise into the sums (no attachments: the fragment shader only does atomics).
         if (!fbo_) fbo_ = kiln::gl::createFramebuffer();
@@ -125,8 +125,8 @@ public:
         glUniform1i(glGetUniformLocation(raster, "u_res"), res);
         glUniform1f(glGetUniformLocation(raster, "u_conservative"), ctx.getBool("conservative") ? 1.0f : 0.0f);
         glUniform1f(glGetUniformLocation(raster, "u_shadowBias"), ctx.getFloat("shadow_bias"));
-        glBindTextureUnit(0, ctx.input("shadow_map").id);
-        bindSums(ctx, GL_READ_WRITE);
+        kiln::gl::bindTexture(raster, "u_shadowMap", ctx.input("shadow_map").id);
+        bindSums(ctx, raster, GL_READ_WRITE);
         uint32_t cats = kiln::kSceneBox | kiln::kSceneTumblers;
         if (!splatFireballs) cats |= kiln::kSceneFireballs;
         if (particles && !splatParticles) cats |= kiln::kSceneParticles;
@@ -138,8 +138,7 @@ public:
         ctx.drawScene({.categories = kiln::kSceneLamp, .lod = kiln::Lod::Low});
         glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
 
-        // The fireballs and particles, splatted (the sums' image units and the shadow map
-        // are still bound). They are neighbours in the instance buffer, fireballs first,
+        // The fireballs and particles, splatted. They are neighbours in the instance buffer, fireballs first,
         // so one dispatch covers both: its first u_litCount spheres are lit. (Two
         // dispatches in a row, with other uniforms, lost most of both on llvmpipe.)
         if (splatter) {
@@ -153,6 +152,8 @@ public:
             const uint32_t count = splatFireballs ? fireballs + sparks : sparks;
             if (count > 0) {
                 glUseProgram(splatter);
+                kiln::gl::bindTexture(splatter, "u_shadowMap", ctx.input("shadow_map").id);
+                bindSums(ctx, splatter, GL_READ_WRITE);
                 glUniform1i(glGetUniformLocation(splatter, "u_res"), res);
                 glUniform1f(glGetUniformLocation(splatter, "u_shadowBias"), ctx.getFloat("shadow_bias"));
                 glUniform1ui(glGetUniformLocation(splatter, "u_first"), first);
@@ -165,25 +166,29 @@ public:
         // 4: resolve the averages.
         glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
         glUseProgram(resolve);
-        bindSums(ctx, GL_READ_ONLY);
-        const GLuint firstResolved = GLuint(std::size(kSums));
-        glBindImageTexture(firstResolved, out.id, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA16F);
-        glBindImageTexture(firstResolved + 1, ctx.output("albedo").id, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA8);
-        glBindImageTexture(firstResolved + 2, ctx.output("normal").id, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA16F);
+        bindSums(ctx, resolve, GL_READ_ONLY);
+        kiln::gl::bindImage(resolve, "u_radiance", out.id, 0, true, GL_WRITE_ONLY, GL_RGBA16F);
+        kiln::gl::bindImage(resolve, "u_albedo", ctx.output("albedo").id, 0, true, GL_WRITE_ONLY, GL_RGBA8);
+        kiln::gl::bindImage(resolve, "u_normal", ctx.output("normal").id, 0, true, GL_WRITE_ONLY, GL_RGBA16F);
         const GLuint groups = GLuint((res + 3) / 4);
         glDispatchCompute(groups, groups, groups);
-        for (GLuint i = 0; i < firstResolved + 3; ++i) glBindImageTexture(i, 0, 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32UI);
     }
 
 private:
-    // The accumulators of shaders/voxelize/sums.glsl, in its image-unit order. The
-    // normal's are signed: R32UI storage viewed as R32I (same size class).
-    static constexpr const char* kSums[] = {"sum_r",    "sum_g",    "sum_b",    "count",   "albedo_r",
-                                            "albedo_g", "albedo_b", "normal_x", "normal_y", "normal_z"};
-    static void bindSums(kiln::PassContext& ctx, GLenum access) {
-        for (GLuint i = 0; i < std::size(kSums); ++i)
-            glBindImageTexture(i, ctx.internal(kSums[i]).id, 0, GL_TRUE, 0, access,
-                               std::string_view(kSums[i]).starts_with("normal") ? GL_R32I : GL_R32UI);
+    // The accumulators: each internal texture and its image in shaders/voxelize/sums.glsl.
+    // The normal's are signed: R32UI storage viewed as R32I (same size class).
+    struct Sum {
+        const char* internal;
+        const char* image;
+    };
+    static constexpr Sum kSums[] = {{"sum_r", "u_sumR"},       {"sum_g", "u_sumG"},       {"sum_b", "u_sumB"},
+                                    {"count", "u_count"},      {"albedo_r", "u_albedoR"}, {"albedo_g", "u_albedoG"},
+                                    {"albedo_b", "u_albedoB"}, {"normal_x", "u_normalX"}, {"normal_y", "u_normalY"},
+                                    {"normal_z", "u_normalZ"}};
+    static void bindSums(kiln::PassContext& ctx, GLuint program, GLenum access) {
+        for (const Sum& sum : kSums)
+            kiln::gl::bindImage(program, sum.image, ctx.internal(sum.internal).id, 0, true, access,
+                                std::string_view(sum.internal).starts_with("normal") ? GL_R32I : GL_R32UI);
     }
 
     kiln::gl::FramebufferHandle fbo_;  // attachment-less; a GL cache only (a reload makes a new one)

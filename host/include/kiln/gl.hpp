@@ -37,6 +37,19 @@ public:
     DebugGroup& operator=(const DebugGroup&) = delete;
 };
 
+// Binding by the shader's own name for a resource: the unit is written once, in the
+// shader's `layout(binding = N)`, and looked up here (glGetUniformiv gives a sampler's
+// texture unit and an image's image unit; a block's GL_BUFFER_BINDING), so the C++ and
+// the GLSL of a pass cannot drift apart. Each returns false, binding nothing, when
+// `program` has no active resource of that name — one the compiler dropped because this
+// variant does not use it; a misspelt name shows as a missing input in the image.
+bool bindTexture(GLuint program, const char* sampler, GLuint texture);
+bool bindSamplerObject(GLuint program, const char* sampler, GLuint samplerObject);
+// `layered`: the whole of a 3D level (true) or one 2D image (false).
+bool bindImage(GLuint program, const char* image, GLuint texture, GLint level, bool layered, GLenum access,
+               GLenum format);
+bool bindStorageBuffer(GLuint program, const char* block, GLuint buffer);
+
 // One owner of a GL name. `Deleter` frees it.
 template <void (*Deleter)(GLuint)>
 class Handle {

@@ -29,7 +29,7 @@
 //         GLuint prog = ctx.program({.stages = {"common/fullscreen.vert", "tint/tint.frag"}});
 //         if (!prog || !ctx.framebuffer({"color"})) return;  // the host shows the error
 //         glUseProgram(prog);
-//         glBindTextureUnit(0, ctx.input("color").id);      // layout(binding = 0) in the shader
+//         kiln::gl::bindTexture(prog, "u_color", ctx.input("color").id);  // the shader's unit
 //         auto t = ctx.getColor("tint");
 //         glUniform3f(glGetUniformLocation(prog, "u_tint"), t[0], t[1], t[2]);
 //         ctx.drawFullscreenTriangle();
@@ -92,11 +92,15 @@
 //   times it (GPU timestamps + CPU clock).
 //
 // TEXTURE UNITS AND BINDINGS
-//   Shaders declare `layout(binding = N)` for every sampler, image and buffer block;
-//   execute() binds to the same N (glBindTextureUnit(N, ...), glBindImageTexture(N,
-//   ...)). Reserved by the host: uniform block binding 0 (common/frame.glsl) and
-//   shader storage binding 0 (the instances of common/instances.glsl) while drawScene
-//   runs.
+//   A unit number is written once, in the shader: `layout(binding = N)` on every
+//   sampler, image and buffer block. execute() binds by the shader's name for it —
+//   kiln::gl::bindTexture(program, "u_color", id), bindImage, bindStorageBuffer,
+//   bindSamplerObject (kiln/gl.hpp) — which looks N up in the linked program, so the
+//   C++ and the GLSL cannot drift apart. A name the program does not use (dropped in
+//   this variant) binds nothing and returns false. Units are GL state shared by every
+//   program of the pass: bind for each program before it runs. Reserved by the host:
+//   uniform block binding 0 (common/frame.glsl) and shader storage binding 0 (the
+//   instances of common/instances.glsl) while drawScene runs.
 //
 // GL STATE
 //   Before each pass the host resets: framebuffer 0 and the viewport to the output
