@@ -449,6 +449,119 @@ std::string csvNumber(double v) {
     return s.str();
 }
 
+// Every setting in rounds (interleaved, so a slow spell of the machine hits them all):
+// errors from the first round (they are deterministic), times the medians of the rounds;
+// the Pareto front marked. False (said on stderr) when a setting fails.
+bool measureAll(app::App& app, const Args& args, const std::vector<Setting>& settings, const Reference& ref,
+                std::vector<Result>& results) {
+    results.assign(settings.size(), Result{});
+    std::vector<std::map<std::string, std::vector<double>>> passSamples(settings.size());
+    std::vector<std::vector<double>> totals(settings.size());
+    for (int round = 0; round < args.repeats; ++round)
+        for (size_t i = 0; i < settings.size(); ++i) {
+            Result r;
+            if (!measure(app, args, settings[i], ref, r)) return false;
+            totals[i].push_back(r.totalMs);
+            for (auto& [id, ms] : r.passMs) passSamples[i][id].push_back(ms);
+            if (round == 0) results[i] = std::move(r);
+        }
+    for (size_t i = 0; i < settings.size(); ++i) {
+        results[i].totalMs = median(totals[i]);
+        for (auto& [id, ms] : results[i].passMs) ms = median(passSamples[i][id]);
+    }
+    markPareto(results);
+    return true;
+}
+
+// The reference's own figures, over the pixels the first setting counts (every
+// pipeline draws the same scene from the same camera, so the emitters are the same).
+struct ReferenceFigures {
+    double halvesSsim = 0, noiseFloor = 0, noiseFloorIndirect = 0;
+    bool ssimMeaningful = false;
+};
+
+ReferenceFigures referenceFigures(const Reference& ref, const Args& args, const metrics::Mask& counted) {
+    ReferenceFigures f;
+    f.halvesSsim = metrics::ssim(metrics::displayLuminance(ref.halves[0]), metrics::displayLuminance(ref.halves[1]),
+                                 args.width, args.height, counted);
+    f.ssimMeaningful = f.halvesSsim >= kSsimMeaningful;
+    f.noiseFloor = metrics::referenceNoiseRelativeMse(ref.halves[0], ref.halves[1], counted);
+    f.noiseFloorIndirect = metrics::referenceNoiseRelativeMse(ref.halvesIndirect[0], ref.halvesIndirect[1], counted);
+    std::printf("\nreference noise floor: relMSE %.5f, indirect %.5f (R's own error against the truth, on expectation;\n"
+                "  the \"corrected\" columns subtract it pixel by pixel: estimates of the error against the truth)\n",
+                f.noiseFloor, f.noiseFloorIndirect);
+    std::printf("reference halves: SSIM(A, B) = %.4f (display luminance, emitters masked)\n", f.halvesSsim);
+    if (!f.ssimMeaningful)
+        std::printf("SSIM withheld: the reference's halves score %.4f against each other (< %.2f); more --spp\n",
+                    f.halvesSsim, kSsimMeaningful);
+    std::printf("\n");
+    return f;
+}
+
+// The error table on stdout and quality.csv, one row per setting each.
+void writeErrors(const std::vector<Result>& results, bool ssimMeaningful, const std::string& csvPath) {
+    std::ofstream csv(csvPath);
+    csv << "setting,total_gpu_ms,rmse,rel_mse,ssim,psnr,pixels,pareto,rel_mse_indirect";
+    for (const char* name : kRegionNames) csv << ",rel_mse_" << name;
+    csv << ",rel_mse_corrected,rel_mse_indirect_corrected";
+    for (const char* kind : {"mean_ratio_", "indirect_ratio_"})
+        for (const char* part : kPartNames) csv << ',' << kind << part << ',' << kind << part << "_uncertainty";
+    csv << ",dome_ring_pixels,rel_mse_dome_ring_corrected,ref_noise_dome_ring,mean_ratio_dome_ring,"
+           "mean_ratio_dome_ring_uncertainty,pass_ms\n";
+    std::printf("%-44s %9s %9s %9s %9s %7s %7s %9s %9s  %-31s %s\n", "setting", "gpu ms", "RMSE", "relMSE", "corrected",
+                "SSIM", "PSNR", "indirect", "corrected", "relMSE floor/walls/ceil/objects", "front");
+    for (const Result& r : results) {
+        char ssimCell[16] = "n/a";
+        if (ssimMeaningful) std::snprintf(ssimCell, sizeof ssimCell, "%.4f", r.errors.ssim);
+        std::printf("%-44s %9.2f %9.5f %9.5f %9.5f %7s %7.2f %9.5f %9.5f  %7.4f %7.4f %7.4f %7.4f  %s\n", r.label.c_str(),
+                    r.totalMs, r.errors.rmse, r.errors.relMse, r.relMseCorrected, ssimCell, r.errors.psnr, r.indirectRelMse,
+                    r.indirectRelMseCorrected, r.regionRelMse[0], r.regionRelMse[1], r.regionRelMse[2], r.regionRelMse[3],
+                    r.pareto ? "*" : "");
+        std::string passes;
+        for (auto& [id, ms] : r.passMs) passes += (passes.empty() ? "" : " ") + id + "=" + std::to_string(ms);
+        csv << '"' << r.label << "\"," << r.totalMs << ',' << r.errors.rmse << ',' << r.errors.relMse << ','
+            << (ssimMeaningful ? csvNumber(r.errors.ssim) : "") << ',' << r.errors.psnr << ',' << r.errors.pixels << ','
+            << (r.pareto ? 1 : 0) << ',' << r.indirectRelMse;
+        for (double v : r.regionRelMse) csv << ',' << v;
+        csv << ',' << r.relMseCorrected << ',' << r.indirectRelMseCorrected;
+        for (const auto* ratios : {r.meanRatio, r.indirectRatio})
+            for (int p = 0; p < kPartCount; ++p)
+                csv << ',' << csvNumber(ratios[p].ratio) << ',' << csvNumber(ratios[p].uncertainty);
+        csv << ',' << r.ringPixels << ',' << r.ringRelMseCorrected << ',' << r.ringNoise << ','
+            << csvNumber(r.ringRatio.ratio) << ',' << csvNumber(r.ringRatio.uncertainty);
+        csv << ",\"" << passes << "\"\n";
+    }
+    std::printf("\n* = on the Pareto front of (GPU ms, corrected relMSE); corrected = less the reference's own noise\n\n");
+}
+
+// The bias table (mean light over the reference's, per region, total and indirect) and
+// the ceiling around the dome.
+void printBias(const std::vector<Result>& results) {
+    std::printf("bias: mean luminance of the setting ÷ the reference's, ± 1σ of the reference's noise\n");
+    std::printf("%-44s  %-65s %s\n%-44s", "", "total", "indirect", "setting");
+    for (int kind = 0; kind < 2; ++kind) {
+        std::printf(" ");
+        for (const char* part : kPartNames) std::printf(" %12s", part);
+    }
+    std::printf("\n");
+    for (const Result& r : results) {
+        std::printf("%-44s", r.label.c_str());
+        for (const auto* ratios : {r.meanRatio, r.indirectRatio}) {
+            std::printf(" ");
+            for (int p = 0; p < kPartCount; ++p) std::printf(" %s", ratioCell(ratios[p]).c_str());
+        }
+        std::printf("\n");
+    }
+    if (!results.empty() && results.front().ringPixels > 0) {
+        std::printf("\nthe ceiling within 0.5 m of the lamp's axis (%d px; the reference's own relMSE there %.5f):\n",
+                    results.front().ringPixels, results.front().ringNoise);
+        std::printf("%-44s %12s %14s\n", "setting", "corrected", "mean light");
+        for (const Result& r : results)
+            std::printf("%-44s %12.5f %14s\n", r.label.c_str(), r.ringRelMseCorrected, ratioCell(r.ringRatio).c_str());
+    }
+
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -479,100 +592,14 @@ int main(int argc, char** argv) {
 
     Reference ref;
     if (!loadReference(app, args, ref)) return 1;
-    // Errors are deterministic (one round gives them); times are medians over the rounds.
-    std::vector<Result> results(settings.size());
-    std::vector<std::map<std::string, std::vector<double>>> passSamples(settings.size());
-    std::vector<std::vector<double>> totals(settings.size());
-    for (int round = 0; round < args.repeats; ++round)
-        for (size_t i = 0; i < settings.size(); ++i) {
-            Result r;
-            if (!measure(app, args, settings[i], ref, r)) return 1;
-            totals[i].push_back(r.totalMs);
-            for (auto& [id, ms] : r.passMs) passSamples[i][id].push_back(ms);
-            if (round == 0) results[i] = std::move(r);
-        }
-    for (size_t i = 0; i < settings.size(); ++i) {
-        results[i].totalMs = median(totals[i]);
-        for (auto& [id, ms] : results[i].passMs) ms = median(passSamples[i][id]);
-    }
-    markPareto(results);
-
-    // The reference's own figures, over the pixels the first setting counts (every
-    // pipeline draws the same scene from the same camera, so the emitters are the same).
-    const metrics::Mask& counted = results.front().counted;
-    const double halvesSsim = metrics::ssim(metrics::displayLuminance(ref.halves[0]), metrics::displayLuminance(ref.halves[1]),
-                                            args.width, args.height, counted);
-    const bool ssimMeaningful = halvesSsim >= kSsimMeaningful;
-    const double noiseFloor = metrics::referenceNoiseRelativeMse(ref.halves[0], ref.halves[1], counted);
-    const double noiseFloorIndirect = metrics::referenceNoiseRelativeMse(ref.halvesIndirect[0], ref.halvesIndirect[1], counted);
-    std::printf("\nreference noise floor: relMSE %.5f, indirect %.5f (R's own error against the truth, on expectation;\n"
-                "  the \"corrected\" columns subtract it pixel by pixel: estimates of the error against the truth)\n",
-                noiseFloor, noiseFloorIndirect);
-    std::printf("reference halves: SSIM(A, B) = %.4f (display luminance, emitters masked)\n", halvesSsim);
-    if (!ssimMeaningful)
-        std::printf("SSIM withheld: the reference's halves score %.4f against each other (< %.2f); more --spp\n", halvesSsim,
-                    kSsimMeaningful);
-    std::printf("\n");
+    std::vector<Result> results;
+    if (!measureAll(app, args, settings, ref, results)) return 1;
+    const ReferenceFigures figures = referenceFigures(ref, args, results.front().counted);
 
     fs::create_directories(args.outDir);
     const std::string csvPath = (fs::path(args.outDir) / "quality.csv").string();
-    std::ofstream csv(csvPath);
-    csv << "setting,total_gpu_ms,rmse,rel_mse,ssim,psnr,pixels,pareto,rel_mse_indirect";
-    for (const char* name : kRegionNames) csv << ",rel_mse_" << name;
-    csv << ",rel_mse_corrected,rel_mse_indirect_corrected";
-    for (const char* kind : {"mean_ratio_", "indirect_ratio_"})
-        for (const char* part : kPartNames) csv << ',' << kind << part << ',' << kind << part << "_uncertainty";
-    csv << ",dome_ring_pixels,rel_mse_dome_ring_corrected,ref_noise_dome_ring,mean_ratio_dome_ring,"
-           "mean_ratio_dome_ring_uncertainty,pass_ms\n";
-    std::printf("%-44s %9s %9s %9s %9s %7s %7s %9s %9s  %-31s %s\n", "setting", "gpu ms", "RMSE", "relMSE", "corrected",
-                "SSIM", "PSNR", "indirect", "corrected", "relMSE floor/walls/ceil/objects", "front");
-    for (auto& r : results) {
-        char ssimCell[16] = "n/a";
-        if (ssimMeaningful) std::snprintf(ssimCell, sizeof ssimCell, "%.4f", r.errors.ssim);
-        std::printf("%-44s %9.2f %9.5f %9.5f %9.5f %7s %7.2f %9.5f %9.5f  %7.4f %7.4f %7.4f %7.4f  %s\n", r.label.c_str(),
-                    r.totalMs, r.errors.rmse, r.errors.relMse, r.relMseCorrected, ssimCell, r.errors.psnr, r.indirectRelMse,
-                    r.indirectRelMseCorrected, r.regionRelMse[0], r.regionRelMse[1], r.regionRelMse[2], r.regionRelMse[3],
-                    r.pareto ? "*" : "");
-        std::string passes;
-        for (auto& [id, ms] : r.passMs) passes += (passes.empty() ? "" : " ") + id + "=" + std::to_string(ms);
-        csv << '"' << r.label << "\"," << r.totalMs << ',' << r.errors.rmse << ',' << r.errors.relMse << ','
-            << (ssimMeaningful ? csvNumber(r.errors.ssim) : "") << ',' << r.errors.psnr << ',' << r.errors.pixels << ','
-            << (r.pareto ? 1 : 0) << ',' << r.indirectRelMse;
-        for (double v : r.regionRelMse) csv << ',' << v;
-        csv << ',' << r.relMseCorrected << ',' << r.indirectRelMseCorrected;
-        for (const auto* ratios : {r.meanRatio, r.indirectRatio})
-            for (int p = 0; p < kPartCount; ++p)
-                csv << ',' << csvNumber(ratios[p].ratio) << ',' << csvNumber(ratios[p].uncertainty);
-        csv << ',' << r.ringPixels << ',' << r.ringRelMseCorrected << ',' << r.ringNoise << ','
-            << csvNumber(r.ringRatio.ratio) << ',' << csvNumber(r.ringRatio.uncertainty);
-        csv << ",\"" << passes << "\"\n";
-    }
-    std::printf("\n* = on the Pareto front of (GPU ms, corrected relMSE); corrected = less the reference's own noise\n\n");
-
-    std::printf("bias: mean luminance of the setting ÷ the reference's, ± 1σ of the reference's noise\n");
-    std::printf("%-44s  %-65s %s\n%-44s", "", "total", "indirect", "setting");
-    for (int kind = 0; kind < 2; ++kind) {
-        std::printf(" ");
-        for (const char* part : kPartNames) std::printf(" %12s", part);
-    }
-    std::printf("\n");
-    for (auto& r : results) {
-        std::printf("%-44s", r.label.c_str());
-        for (const auto* ratios : {r.meanRatio, r.indirectRatio}) {
-            std::printf(" ");
-            for (int p = 0; p < kPartCount; ++p) std::printf(" %s", ratioCell(ratios[p]).c_str());
-        }
-        std::printf("\n");
-    }
-    if (!results.empty() && results.front().ringPixels > 0) {
-        std::printf("\nthe ceiling within 0.5 m of the lamp's axis (%d px; the reference's own relMSE there %.5f):\n",
-                    results.front().ringPixels, results.front().ringNoise);
-        std::printf("%-44s %12s %14s\n", "setting", "corrected", "mean light");
-        for (auto& r : results)
-            std::printf("%-44s %12.5f %14s\n", r.label.c_str(), r.ringRelMseCorrected, ratioCell(r.ringRatio).c_str());
-    }
-
-    csv.close();  // complete on disk before the plot script reads it
+    writeErrors(results, figures.ssimMeaningful, csvPath);
+    printBias(results);
     const std::string pngPath = (fs::path(args.outDir) / "quality.png").string();
     std::vector<std::string> plotArgs{"quality", csvPath, pngPath};
     for (auto& also : args.also) plotArgs.insert(plotArgs.end(), {"--highlight", fs::path(also).stem().string()});
@@ -589,11 +616,11 @@ int main(int argc, char** argv) {
         {"spp_per_half", args.spp / 2},
         {"seeds", {kHalfSeeds[0], kHalfSeeds[1]}},
         {"pixels", results.front().errors.pixels},
-        {"ssim_halves", halvesSsim},
+        {"ssim_halves", figures.halvesSsim},
         {"ssim_threshold", kSsimMeaningful},
-        {"ssim_reported", ssimMeaningful},
-        {"ref_noise_rel_mse", noiseFloor},
-        {"ref_noise_rel_mse_indirect", noiseFloorIndirect},
+        {"ssim_reported", figures.ssimMeaningful},
+        {"ref_noise_rel_mse", figures.noiseFloor},
+        {"ref_noise_rel_mse_indirect", figures.noiseFloorIndirect},
         {"reference_render_s", ref.renderSeconds},
         {"wall_s", std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count()},
         {"frames", args.frames},
