@@ -167,9 +167,39 @@ void TextureViewer::window(const run::NamedTexture& nt, bool* open) {
         return;
     }
     ImGui::PushID(name.c_str());
+    const bool fitNow = controls(nt, s);
+
+    // The canvas: what is left of the window but the readout and histogram lines.
+    const float footer = ImGui::GetTextLineHeightWithSpacing() * 2.0f + 56.0f;
+    const ImVec2 avail = ImGui::GetContentRegionAvail();
+    const glm::ivec2 size(std::max(16, int(avail.x)), std::max(16, int(avail.y - footer)));
+    ensureCanvas(size);
+    if (fitFor_ != name) fit_.reset(), readout_.reset(), fitFor_ = name;
+    // Data without a natural 0..1 (depth, counts, one float channel) is fitted when first
+    // shown; colour starts at 0..1.
+    if (!s.fitted && !isSingleChannel(t.format)) s.fitted = true;
+    if (!s.fitted) s.channel = 1;  // one channel: shown in false colour
+    if (fitNow || autoFit_ || !s.fitted) fit_ = fitRange(t, nt.depthNear, nt.depthFar, s, glm::vec2(size)), s.fitted = true;
+    glBindFramebuffer(GL_FRAMEBUFFER, canvasFbo_.id());
+    draw(t, nt.depthNear, nt.depthFar, s, {0, 0, size.x, size.y});
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+
+    const ImVec2 p0 = ImGui::GetCursorScreenPos();
+    ImGui::InvisibleButton("canvas", ImVec2(float(size.x), float(size.y)));
+    const bool hovered = ImGui::IsItemHovered(), active = ImGui::IsItemActive();
+    canvasRect_ = {p0.x, p0.y, p0.x + size.x, p0.y + size.y};
+    ImGui::GetWindowDrawList()->AddImage(ImTextureID(intptr_t(canvas_.id())), p0, ImVec2(p0.x + size.x, p0.y + size.y),
+                                         ImVec2(0, 1), ImVec2(1, 0));
+    canvasInput(t, s, glm::vec2(p0.x, p0.y), size, hovered, active);
+    readoutAndHistogram(nt, name);
+    ImGui::PopID();
+    ImGui::End();
+}
+
+bool TextureViewer::controls(const run::NamedTexture& nt, ViewSettings& s) {
+    const TextureRef& t = nt.ref;
     const bool is3D = t.target == GL_TEXTURE_3D;
-    const bool depthPlanes = isDepthFormat(t.format) && nt.depthNear > 0.0f;
-    ImGui::Text("%s  %dx%d%s %s, %d mip%s", name.c_str(), t.width, t.height,
+    ImGui::Text("%s.%s  %dx%d%s %s, %d mip%s", nt.pass.c_str(), nt.name.c_str(), t.width, t.height,
                 is3D ? ("x" + std::to_string(t.depth)).c_str() : "", gl::formatName(t.format), t.levels, t.levels == 1 ? "" : "s");
     const char* channels[] = {"RGB", "R", "G", "B", "A"};
     ImGui::SetNextItemWidth(70);
@@ -187,7 +217,7 @@ void TextureViewer::window(const run::NamedTexture& nt, bool* open) {
     if (s.channel != 0) ImGui::Checkbox("false colour", &s.falseColor), ImGui::SameLine();
     ImGui::Checkbox("alpha checkerboard", &s.checker);
     if (s.channel == 0) ImGui::SameLine(), ImGui::Checkbox("tonemap", &s.tonemap);
-    if (depthPlanes) {
+    if (isDepthFormat(t.format) && nt.depthNear > 0.0f) {
         ImGui::SameLine();
         ImGui::Checkbox("depth in metres", &s.linearizeDepth);
         if (ImGui::IsItemHovered()) ImGui::SetTooltip("linearised with the producing camera's planes %.3g .. %.3g", nt.depthNear, nt.depthFar);
@@ -202,37 +232,22 @@ void TextureViewer::window(const run::NamedTexture& nt, bool* open) {
         int slice = clampedSlice(t, s, mip);
         if (ImGui::SliderInt("slice", &slice, 0, levelSize(t, mip)[s.axis] - 1)) s.slice = slice;
     }
+    return fitNow;
+}
 
-    // The canvas: what is left of the window but the readout and histogram lines.
-    const float footer = ImGui::GetTextLineHeightWithSpacing() * 2.0f + 56.0f;
-    const ImVec2 avail = ImGui::GetContentRegionAvail();
-    const glm::ivec2 size(std::max(16, int(avail.x)), std::max(16, int(avail.y - footer)));
-    if (canvas_.width() != size.x || canvas_.height() != size.y) {
-        canvas_ = gl::Texture::create(GL_TEXTURE_2D, GL_RGBA8, size.x, size.y, 1, 1, "kiln.texture_viewer");
-        GLuint fbo = 0;
-        glCreateFramebuffers(1, &fbo);
-        canvasFbo_ = gl::FramebufferHandle(fbo);
-        glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0, canvas_.id(), 0);
-    }
+void TextureViewer::ensureCanvas(glm::ivec2 size) {
+    if (canvas_.width() == size.x && canvas_.height() == size.y) return;
+    canvas_ = gl::Texture::create(GL_TEXTURE_2D, GL_RGBA8, size.x, size.y, 1, 1, "kiln.texture_viewer");
+    canvasFbo_ = gl::createFramebuffer();
+    glNamedFramebufferTexture(canvasFbo_.id(), GL_COLOR_ATTACHMENT0, canvas_.id(), 0);
+}
+
+void TextureViewer::canvasInput(const TextureRef& t, ViewSettings& s, glm::vec2 p0, glm::ivec2 size, bool hovered,
+                                bool active) {
+    const ImGuiIO& io = ImGui::GetIO();
     const int mip = clampedMip(t, s);
     const glm::ivec2 plane = planeSize(t, mip, s.axis);
     const glm::vec2 canvas(size);
-    if (fitFor_ != name) fit_.reset(), readout_.reset(), fitFor_ = name;
-    // Data without a natural 0..1 (depth, counts, one float channel) is fitted when first
-    // shown; colour starts at 0..1.
-    if (!s.fitted && !isSingleChannel(t.format)) s.fitted = true;
-    if (!s.fitted) s.channel = 1;  // one channel: shown in false colour
-    if (fitNow || autoFit_ || !s.fitted) fit_ = fitRange(t, nt.depthNear, nt.depthFar, s, canvas), s.fitted = true;
-    glBindFramebuffer(GL_FRAMEBUFFER, canvasFbo_.id());
-    draw(t, nt.depthNear, nt.depthFar, s, {0, 0, size.x, size.y});
-    glBindFramebuffer(GL_FRAMEBUFFER, 0);
-
-    const ImVec2 p0 = ImGui::GetCursorScreenPos();
-    ImGui::InvisibleButton("canvas", ImVec2(float(size.x), float(size.y)));
-    const bool hovered = ImGui::IsItemHovered(), active = ImGui::IsItemActive();
-    canvasRect_ = {p0.x, p0.y, p0.x + size.x, p0.y + size.y};
-    ImGui::GetWindowDrawList()->AddImage(ImTextureID(intptr_t(canvas_.id())), p0, ImVec2(p0.x + size.x, p0.y + size.y),
-                                         ImVec2(0, 1), ImVec2(1, 0));
     // Canvas pixel of the cursor, origin bottom-left like the shader's.
     const glm::vec2 cursor(io.MousePos.x - p0.x, float(size.y) - (io.MousePos.y - p0.y));
     if (active && ImGui::IsMouseDragging(ImGuiMouseButton_Left, 0.0f)) {
@@ -246,24 +261,26 @@ void TextureViewer::window(const run::NamedTexture& nt, bool* open) {
         s.zoom = zoom;
         s.center = under - (cursor - canvas * 0.5f) / zoom;  // the texel under the cursor stays put
     }
-    if (hovered) {
-        const glm::ivec2 p(glm::floor(texelAt(cursor, canvas, s, plane)));
-        if (p.x >= 0 && p.y >= 0 && p.x < plane.x && p.y < plane.y) {
-            TexelReadout r;
-            r.texel = planeToTexture(p, s.axis, clampedSlice(t, s, mip), is3D);
-            r.mip = mip;
-            const std::vector<float> v = readTexelBox(t, mip, r.texel, {1, 1, 1});
-            r.value = {v[0], v[1], v[2], v[3]};
-            r.isInteger = gl::isIntegerFormat(t.format);
-            r.isDepth = isDepthFormat(t.format);
-            readout_ = r;
-        }
-    }
+    if (!hovered) return;
+    const glm::ivec2 p(glm::floor(texelAt(cursor, canvas, s, plane)));
+    if (p.x < 0 || p.y < 0 || p.x >= plane.x || p.y >= plane.y) return;
+    TexelReadout r;
+    r.texel = planeToTexture(p, s.axis, clampedSlice(t, s, mip), t.target == GL_TEXTURE_3D);
+    r.mip = mip;
+    const std::vector<float> v = readTexelBox(t, mip, r.texel, {1, 1, 1});
+    r.value = {v[0], v[1], v[2], v[3]};
+    r.isInteger = gl::isIntegerFormat(t.format);
+    r.isDepth = isDepthFormat(t.format);
+    readout_ = r;
+}
+
+void TextureViewer::readoutAndHistogram(const run::NamedTexture& nt, const std::string& name) {
     if (readout_) {
         const TexelReadout& r = *readout_;
+        const bool is3D = nt.ref.target == GL_TEXTURE_3D;
         ImGui::Text("texel %d, %d%s  mip %d", r.texel.x, r.texel.y, is3D ? (", " + std::to_string(r.texel.z)).c_str() : "", r.mip);
         if (r.isInteger) ImGui::Text("value %u", unsigned(r.value.r));
-        else if (r.isDepth && depthPlanes)
+        else if (r.isDepth && nt.depthNear > 0.0f)
             ImGui::Text("depth %.7g  (%.5g m from the camera)", r.value.r, linearDepth(r.value.r, nt.depthNear, nt.depthFar));
         else if (r.isDepth) ImGui::Text("depth %.7g", r.value.r);
         else ImGui::Text("%.6g  %.6g  %.6g  %.6g", r.value.r, r.value.g, r.value.b, r.value.a);
@@ -277,8 +294,6 @@ void TextureViewer::window(const run::NamedTexture& nt, bool* open) {
                       fit_->nonFinite ? ", some NaN/Inf" : "");
         ImGui::PlotHistogram("##histogram", fit_->histogram.data(), 64, 0, overlay, 0.0f, FLT_MAX, ImVec2(-1, 48));
     }
-    ImGui::PopID();
-    ImGui::End();
 }
 
 }  // namespace kiln::app

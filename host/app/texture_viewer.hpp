@@ -80,6 +80,15 @@ public:
     static RangeFit fitRange(const TextureRef&, float depthNear, float depthFar, ViewSettings& s, glm::vec2 canvasSize);
 
 private:
+    // The parts of window(): the controls above the image (true: "fit range" pressed),
+    // the canvas texture at `size`, the mouse over it (pan, zoom, the texel under the
+    // cursor), the readout and histogram below it.
+    bool controls(const run::NamedTexture& nt, ViewSettings& s);
+    void ensureCanvas(glm::ivec2 size);
+    void canvasInput(const TextureRef& t, ViewSettings& s, glm::vec2 canvasTopLeft, glm::ivec2 size, bool hovered,
+                     bool active);
+    void readoutAndHistogram(const run::NamedTexture& nt, const std::string& name);
+
     gl::ProgramHandle program_;
     gl::VertexArrayHandle vao_;
     gl::Texture canvas_;           // the ImGui window's image, redrawn every frame
