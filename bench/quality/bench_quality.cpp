@@ -562,6 +562,40 @@ void printBias(const std::vector<Result>& results) {
 
 }
 
+// The run's header: what was measured, the reference's figures, how long it took.
+// null where a figure has no value (nlohmann writes NaN as null).
+nlohmann::json summary(const Args& args, const std::string& device, double sceneTime, const std::vector<Result>& results,
+                       const ReferenceFigures& figures, const Reference& ref,
+                       std::chrono::steady_clock::time_point started) {
+    return {
+        {"device", device},
+        {"scene", args.scene},
+        {"scene_time_s", sceneTime},
+        {"width", args.width},
+        {"height", args.height},
+        {"spp", args.spp},
+        {"spp_per_half", args.spp / 2},
+        {"seeds", {kHalfSeeds[0], kHalfSeeds[1]}},
+        {"pixels", results.front().errors.pixels},
+        {"ssim_halves", figures.halvesSsim},
+        {"ssim_threshold", kSsimMeaningful},
+        {"ssim_reported", figures.ssimMeaningful},
+        {"ref_noise_rel_mse", figures.noiseFloor},
+        {"ref_noise_rel_mse_indirect", figures.noiseFloorIndirect},
+        {"reference_render_s", ref.renderSeconds},
+        {"wall_s", std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count()},
+        {"frames", args.frames},
+        {"repeats", args.repeats},
+        {"settings", results.size()},
+    };
+}
+
+bool plotQuality(const Args& args, const std::string& csvPath, const std::string& pngPath, std::string& error) {
+    std::vector<std::string> plotArgs{"quality", csvPath, pngPath};
+    for (auto& also : args.also) plotArgs.insert(plotArgs.end(), {"--highlight", fs::path(also).stem().string()});
+    return kiln::drawPlot(plotArgs, error);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -601,34 +635,11 @@ int main(int argc, char** argv) {
     writeErrors(results, figures.ssimMeaningful, csvPath);
     printBias(results);
     const std::string pngPath = (fs::path(args.outDir) / "quality.png").string();
-    std::vector<std::string> plotArgs{"quality", csvPath, pngPath};
-    for (auto& also : args.also) plotArgs.insert(plotArgs.end(), {"--highlight", fs::path(also).stem().string()});
-    if (!kiln::drawPlot(plotArgs, error)) return fail(error) ? 0 : 1;
+    if (!plotQuality(args, csvPath, pngPath, error)) return fail(error) ? 0 : 1;
 
-    // null where a figure has no value (nlohmann writes NaN as null).
-    const nlohmann::json summary = {
-        {"device", context->description()},
-        {"scene", args.scene},
-        {"scene_time_s", app.scene().time()},
-        {"width", args.width},
-        {"height", args.height},
-        {"spp", args.spp},
-        {"spp_per_half", args.spp / 2},
-        {"seeds", {kHalfSeeds[0], kHalfSeeds[1]}},
-        {"pixels", results.front().errors.pixels},
-        {"ssim_halves", figures.halvesSsim},
-        {"ssim_threshold", kSsimMeaningful},
-        {"ssim_reported", figures.ssimMeaningful},
-        {"ref_noise_rel_mse", figures.noiseFloor},
-        {"ref_noise_rel_mse_indirect", figures.noiseFloorIndirect},
-        {"reference_render_s", ref.renderSeconds},
-        {"wall_s", std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count()},
-        {"frames", args.frames},
-        {"repeats", args.repeats},
-        {"settings", results.size()},
-    };
     const std::string summaryPath = (fs::path(args.outDir) / "summary.json").string();
-    std::ofstream(summaryPath) << summary.dump(2) << '\n';
+    std::ofstream(summaryPath) << summary(args, context->description(), app.scene().time(), results, figures, ref,
+                                          started).dump(2) << '\n';
     std::printf("wrote %s, %s and %s\n", csvPath.c_str(), pngPath.c_str(), summaryPath.c_str());
     return 0;
 }

@@ -268,6 +268,85 @@ std::string oneLineObject(const std::vector<std::pair<std::string, std::string>>
     return out + (spaced ? " }" : "}");
 }
 
+// Pass i's parameters: a changed value becomes an edit of its text; a new one goes to
+// `added` (key and value as JSON text) for passEdits to place.
+bool paramValueEdits(size_t i, const PassDesc& was, const PassDesc& now, const JsonSpan::Member* params,
+                     std::vector<TextEdit>& edits, std::vector<std::pair<std::string, std::string>>& added,
+                     std::string& error) {
+    for (const auto& [name, value] : now.params) {
+        const ParamLiteral* before = nullptr;
+        for (const auto& p : was.params)
+            if (p.first == name) before = &p.second;
+        try {
+            if (!before) {
+                added.emplace_back(keyText(name), literalText(value));
+            } else if (!sameLiteral(*before, value)) {
+                const JsonSpan::Member* m = params ? params->value.member(name) : nullptr;
+                if (!m) {
+                    error = passLabel(i, was) + ": cannot find parameter \"" + elide(name, 40) + "\" in the text";
+                    return false;
+                }
+                edits.push_back({m->value.begin, m->value.end, literalText(value)});
+            }
+        } catch (const std::runtime_error& e) {
+            error = passLabel(i, was) + ": parameter \"" + elide(name, 40) + "\": " + e.what();
+            return false;
+        }
+    }
+    return true;
+}
+
+// The edits that turn pass i of the text from `was` into `now`: its enabled flag, its
+// changed parameters' values, its added parameters (after the last one, or a new
+// "params" object after "module", spaced like its neighbours). False with `error` when
+// the text does not hold what the parser read.
+bool passEdits(const std::string& original, size_t i, const PassDesc& was, const PassDesc& now, const JsonSpan& pass,
+               std::vector<TextEdit>& edits, std::string& error) {
+    const JsonSpan::Member* module = pass.member("module");
+    const JsonSpan::Member* enabled = pass.member("enabled");
+    const JsonSpan::Member* params = pass.member("params");
+    if (!module || (params && params->value.kind != '{')) {
+        error = passLabel(i, was) + ": cannot find its keys in the text";
+        return false;
+    }
+    // Spacing of a key added next to `m`: the whitespace before m's key, the bytes
+    // between its key and its value.
+    auto lead = [&](const JsonSpan::Member& m) {
+        return original.substr(m.leadBegin, m.keyBegin - m.leadBegin);
+    };
+    auto colon = [&](const JsonSpan::Member& m) {
+        return original.substr(m.keyEnd, m.value.begin - m.keyEnd);
+    };
+    std::string afterModule;  // keys added after "module", in writePipeline's order
+
+    if (was.enabled != now.enabled) {
+        const std::string value = now.enabled ? "true" : "false";
+        if (enabled)
+            edits.push_back({enabled->value.begin, enabled->value.end, value});
+        else  // only a pass turned off can lack the key
+            afterModule += "," + lead(*module) + "\"enabled\"" + colon(*module) + value;
+    }
+
+    std::vector<std::pair<std::string, std::string>> added;  // key text, value text
+    if (!paramValueEdits(i, was, now, params, edits, added, error)) return false;
+    if (!added.empty()) {
+        if (!params) {
+            afterModule += "," + lead(*module) + "\"params\"" + colon(*module) +
+                           oneLineObject(added, colon(*module), !lead(*module).empty());
+        } else if (params->value.members.empty()) {
+            edits.push_back({params->value.begin, params->value.end,
+                             oneLineObject(added, colon(*params), !lead(*params).empty())});
+        } else {
+            const JsonSpan::Member& last = params->value.members.back();
+            std::string text;
+            for (const auto& [key, value] : added) text += "," + lead(last) + key + colon(last) + value;
+            edits.push_back({last.value.end, last.value.end, std::move(text)});
+        }
+    }
+    if (!afterModule.empty()) edits.push_back({module->value.end, module->value.end, std::move(afterModule)});
+    return true;
+}
+
 }  // namespace
 
 std::optional<std::string> patchPipelineText(const std::string& original, const PipelineDesc& edited,
@@ -294,72 +373,9 @@ std::optional<std::string> patchPipelineText(const std::string& original, const 
 
     std::vector<TextEdit> edits;
     try {
-        for (size_t i = 0; i < file.passes.size(); ++i) {
-            const PassDesc& was = file.passes[i];
-            const PassDesc& now = edited.passes[i];
-            const JsonSpan& pass = passesMember->value.items[i];
-            const JsonSpan::Member* module = pass.member("module");
-            const JsonSpan::Member* enabled = pass.member("enabled");
-            const JsonSpan::Member* params = pass.member("params");
-            if (!module || (params && params->value.kind != '{')) {
-                error = passLabel(i, was) + ": cannot find its keys in the text";
+        for (size_t i = 0; i < file.passes.size(); ++i)
+            if (!passEdits(original, i, file.passes[i], edited.passes[i], passesMember->value.items[i], edits, error))
                 return std::nullopt;
-            }
-            // Spacing of a key added next to `m`: the whitespace before m's key, the bytes
-            // between its key and its value.
-            auto lead = [&](const JsonSpan::Member& m) {
-                return original.substr(m.leadBegin, m.keyBegin - m.leadBegin);
-            };
-            auto colon = [&](const JsonSpan::Member& m) {
-                return original.substr(m.keyEnd, m.value.begin - m.keyEnd);
-            };
-            std::string afterModule;  // keys added after "module", in writePipeline's order
-
-            if (was.enabled != now.enabled) {
-                const std::string value = now.enabled ? "true" : "false";
-                if (enabled)
-                    edits.push_back({enabled->value.begin, enabled->value.end, value});
-                else  // only a pass turned off can lack the key
-                    afterModule += "," + lead(*module) + "\"enabled\"" + colon(*module) + value;
-            }
-
-            std::vector<std::pair<std::string, std::string>> added;  // key text, value text
-            for (const auto& [name, value] : now.params) {
-                const ParamLiteral* before = nullptr;
-                for (const auto& p : was.params)
-                    if (p.first == name) before = &p.second;
-                try {
-                    if (!before) {
-                        added.emplace_back(keyText(name), literalText(value));
-                    } else if (!sameLiteral(*before, value)) {
-                        const JsonSpan::Member* m = params ? params->value.member(name) : nullptr;
-                        if (!m) {
-                            error = passLabel(i, was) + ": cannot find parameter \"" + elide(name, 40) + "\" in the text";
-                            return std::nullopt;
-                        }
-                        edits.push_back({m->value.begin, m->value.end, literalText(value)});
-                    }
-                } catch (const std::runtime_error& e) {
-                    error = passLabel(i, was) + ": parameter \"" + elide(name, 40) + "\": " + e.what();
-                    return std::nullopt;
-                }
-            }
-            if (!added.empty()) {
-                if (!params) {
-                    afterModule += "," + lead(*module) + "\"params\"" + colon(*module) +
-                                   oneLineObject(added, colon(*module), !lead(*module).empty());
-                } else if (params->value.members.empty()) {
-                    edits.push_back({params->value.begin, params->value.end,
-                                     oneLineObject(added, colon(*params), !lead(*params).empty())});
-                } else {
-                    const JsonSpan::Member& last = params->value.members.back();
-                    std::string text;
-                    for (const auto& [key, value] : added) text += "," + lead(last) + key + colon(last) + value;
-                    edits.push_back({last.value.end, last.value.end, std::move(text)});
-                }
-            }
-            if (!afterModule.empty()) edits.push_back({module->value.end, module->value.end, std::move(afterModule)});
-        }
     } catch (const std::runtime_error& e) {
         error = e.what();
         return std::nullopt;
