@@ -242,6 +242,20 @@ std::optional<std::string> trialOpen(const fs::path& file) {
     if (WIFEXITED(status) && WEXITSTATUS(status) == kThrewStatus) return std::string("an exception");
     return std::nullopt;
 }
+// What is wrong with what kiln_pass_module() gave, if anything: a message, or "".
+std::string descriptorProblem(const fs::path& source, const std::string& name, bool hasEntry,
+                              const KilnPassModule* desc) {
+    if (!hasEntry) return source.string() + ": not a Kiln pass module (no exported symbol kiln_pass_module)";
+    if (!desc) return source.string() + ": kiln_pass_module() returned null";
+    if (desc->abiVersion != kPassAbiVersion)
+        return source.string() + ": built for pass ABI version " + std::to_string(desc->abiVersion) +
+               ", this host speaks version " + std::to_string(kPassAbiVersion) + "; rebuild the module";
+    if (!desc->name || name != desc->name || !desc->create || !desc->destroy)
+        return source.string() + ": descriptor names module \"" + (desc->name ? desc->name : "(null)") +
+               "\" or lacks a factory; the file name and KILN_PASS_MODULE name must match";
+    return "";
+}
+
 }  // namespace
 
 bool ModuleLoader::checkFile(const fs::path& file, std::string& why) { return checkElf(file, why); }
@@ -251,32 +265,13 @@ std::shared_ptr<LoadedModule> ModuleLoader::load(const std::string& name, std::s
         error = "module name \"" + name + "\" is not valid: a module is named by " + std::string(kNameRule) + ", no path, \"..\" or suffix";
         return nullptr;
     }
-    fs::path source = locate(name);
+    const fs::path source = locate(name);
     if (source.empty()) {
-        std::string dirs;
-        for (auto& d : dirs_) dirs += (dirs.empty() ? "" : ", ") + d.string();
-        auto names = available();
-        std::string hint = nearestName(name, names);
-        error = "no module \"" + name + "\" (" + fileNameFor(name) + ") in " + (dirs.empty() ? "no module directory" : dirs) +
-                (hint.empty() ? "" : "; did you mean \"" + hint + "\"?") + " (available: " + joined(names) + ")";
+        error = notFound(name);
         return nullptr;
     }
-
-    // A private copy under a name never used before in this process (not only by this
-    // loader: a faulted library stays mapped): dlopen would hand back a cached handle for
-    // a path it has seen, and the linker may rewrite the original.
-    static std::atomic<unsigned> serial{0};
-    std::error_code ec;
-    fs::create_directories(scratch_, ec);
-    fs::path copy = scratch_ / (fileNameFor(name) + "." + std::to_string(++serial));
-    fs::path tmp = copy;
-    tmp += ".tmp";
-    fs::copy_file(source, tmp, fs::copy_options::overwrite_existing, ec);
-    if (!ec) fs::rename(tmp, copy, ec);
-    if (ec) {
-        error = source.string() + ": cannot copy for loading: " + ec.message();
-        return nullptr;
-    }
+    const fs::path copy = privateCopy(source, name, error);
+    if (copy.empty()) return nullptr;
 
     auto module = std::shared_ptr<LoadedModule>(new LoadedModule());
     module->name_ = name;
@@ -321,26 +316,35 @@ std::shared_ptr<LoadedModule> ModuleLoader::load(const std::string& name, std::s
         return nullptr;
     }
     module->code_ = codeOf(module->handle_);
-    if (!hasEntry) {
-        error = source.string() + ": not a Kiln pass module (no exported symbol kiln_pass_module)";
-        return nullptr;
-    }
-    if (!desc) {
-        error = source.string() + ": kiln_pass_module() returned null";
-        return nullptr;
-    }
-    if (desc->abiVersion != kPassAbiVersion) {
-        error = source.string() + ": built for pass ABI version " + std::to_string(desc->abiVersion) +
-                ", this host speaks version " + std::to_string(kPassAbiVersion) + "; rebuild the module";
-        return nullptr;
-    }
-    if (!desc->name || name != desc->name || !desc->create || !desc->destroy) {
-        error = source.string() + ": descriptor names module \"" + (desc->name ? desc->name : "(null)") +
-                "\" or lacks a factory; the file name and KILN_PASS_MODULE name must match";
+    if (std::string refused = descriptorProblem(source, name, hasEntry, desc); !refused.empty()) {
+        error = refused;
         return nullptr;
     }
     module->desc_ = desc;
     return module;
+}
+
+std::string ModuleLoader::notFound(const std::string& name) const {
+    std::string dirs;
+    for (auto& d : dirs_) dirs += (dirs.empty() ? "" : ", ") + d.string();
+    const auto names = available();
+    const std::string hint = nearestName(name, names);
+    return "no module \"" + name + "\" (" + fileNameFor(name) + ") in " + (dirs.empty() ? "no module directory" : dirs) +
+           (hint.empty() ? "" : "; did you mean \"" + hint + "\"?") + " (available: " + joined(names) + ")";
+}
+
+fs::path ModuleLoader::privateCopy(const fs::path& source, const std::string& name, std::string& error) const {
+    static std::atomic<unsigned> serial{0};
+    std::error_code ec;
+    fs::create_directories(scratch_, ec);
+    const fs::path copy = scratch_ / (fileNameFor(name) + "." + std::to_string(++serial));
+    fs::path tmp = copy;
+    tmp += ".tmp";
+    fs::copy_file(source, tmp, fs::copy_options::overwrite_existing, ec);
+    if (!ec) fs::rename(tmp, copy, ec);
+    if (!ec) return copy;
+    error = source.string() + ": cannot copy for loading: " + ec.message();
+    return {};
 }
 
 PassPtr ModuleLoader::create(const std::shared_ptr<LoadedModule>& module, std::string& error) {

@@ -92,6 +92,15 @@ public:
     static bool checkFile(const std::filesystem::path& file, std::string& why);
 
 private:
+    // Why `name` was not found: where it looked, the nearest name, what is there.
+    std::string notFound(const std::string& name) const;
+    // A private copy of `source` under a name never used before in this process (not
+    // only by this loader: a faulted library stays mapped): dlopen would hand back a
+    // cached handle for a path it has seen, and the linker may rewrite the original.
+    // Empty, with `error`, when it cannot be made.
+    std::filesystem::path privateCopy(const std::filesystem::path& source, const std::string& name,
+                                      std::string& error) const;
+
     std::vector<std::filesystem::path> dirs_;
     std::filesystem::path scratch_;  // private copies of loaded libraries
 };
