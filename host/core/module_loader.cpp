@@ -242,6 +242,19 @@ std::optional<std::string> trialOpen(const fs::path& file) {
     if (WIFEXITED(status) && WEXITSTATUS(status) == kThrewStatus) return std::string("an exception");
     return std::nullopt;
 }
+// dlopen and kiln_pass_module(): the descriptor, or null with `opened`/`hasEntry` saying
+// how far it got.
+const KilnPassModule* openAndDescribe(const fs::path& copy, void*& handle, bool& opened, bool& hasEntry) {
+    using EntryFn = const KilnPassModule* (*)();
+    handle = dlopen(copy.c_str(), RTLD_NOW | RTLD_LOCAL);
+    if (!handle) return nullptr;
+    opened = true;
+    auto entry = reinterpret_cast<EntryFn>(dlsym(handle, "kiln_pass_module"));
+    if (!entry) return nullptr;
+    hasEntry = true;
+    return entry();
+}
+
 // What is wrong with what kiln_pass_module() gave, if anything: a message, or "".
 std::string descriptorProblem(const fs::path& source, const std::string& name, bool hasEntry,
                               const KilnPassModule* desc) {
@@ -291,21 +304,11 @@ std::shared_ptr<LoadedModule> ModuleLoader::load(const std::string& name, std::s
         return nullptr;
     }
     // The child came through; the guard is for a library that behaves otherwise here.
-    using EntryFn = const KilnPassModule* (*)();
+    // Not watched: dlopen holds the dynamic loader's lock (the child timed the loops).
     const KilnPassModule* desc = nullptr;
     bool opened = false, hasEntry = false;
-    // Not watched: dlopen holds the dynamic loader's lock (the child timed the loops).
-    if (auto fault = guard::guarded(
-            [&] {
-                module->handle_ = dlopen(copy.c_str(), RTLD_NOW | RTLD_LOCAL);
-                if (!module->handle_) return;
-                opened = true;
-                auto entry = reinterpret_cast<EntryFn>(dlsym(module->handle_, "kiln_pass_module"));
-                if (!entry) return;
-                hasEntry = true;
-                desc = entry();
-            },
-            guard::kUnwatched)) {
+    if (auto fault = guard::guarded([&] { desc = openAndDescribe(copy, module->handle_, opened, hasEntry); },
+                                    guard::kUnwatched)) {
         error = cannotLoad(*fault);
         module->markFaulted(error);
         return nullptr;
