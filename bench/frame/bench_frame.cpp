@@ -159,6 +159,77 @@ std::string editedPipeline(const std::string& text, bool cullBloom, bool disable
     return j.dump(2);
 }
 
+// Every situation in rotating rounds, then each one's medians.
+std::vector<Outcome> measureRounds(app::App& app, const std::vector<Situation>& situations, const Args& args) {
+    std::vector<std::vector<Outcome>> rounds(situations.size());
+    // Each round starts one situation later: the situation that follows the fireball-free
+    // scene measured up to 1.3x slower in every pass, whichever it was (a driver state we
+    // have not pinned down), so no situation may always sit in that slot.
+    for (int r = 0; r < args.repeats; ++r)
+        for (size_t k = 0; k < situations.size(); ++k) {
+            const size_t i = (k + size_t(r)) % situations.size();
+            rounds[i].push_back(runSituation(app, situations[i], args.frames));
+        }
+    std::vector<Outcome> outcomes;
+    for (auto& all : rounds) {
+        Outcome o = all.front();
+        auto med = [&](auto get) {
+            std::vector<double> v;
+            for (auto& x : all) v.push_back(get(x));
+            return median(v);
+        };
+        o.frameMs = med([](const Outcome& x) { return x.frameMs; });
+        o.hostMs = med([](const Outcome& x) { return x.hostMs; });
+        o.passesMs = med([](const Outcome& x) { return x.passesMs; });
+        for (size_t p = 0; p < o.passes.size(); ++p) {
+            o.passes[p].gpuMs = med([&](const Outcome& x) { return x.passes[p].gpuMs; });
+            o.passes[p].cpuMs = med([&](const Outcome& x) { return x.passes[p].cpuMs; });
+        }
+        outcomes.push_back(std::move(o));
+    }
+
+    return outcomes;
+}
+
+// kiln-bench-overhead's table: the graph's own CPU per frame, and the guard's cost.
+void reportOverhead(const std::vector<Outcome>& outcomes, const Args& args, std::ofstream& csv) {
+    csv << "situation,frame_cpu_ms,passes_cpu_ms,graph_cpu_ms,graph_share\n";
+    std::printf("%-10s %14s %14s %14s %8s\n", "situation", "renderFrame ms", "in passes ms", "graph's own ms", "share");
+    for (const Outcome& r : outcomes) {
+        const double total = r.hostMs + r.passesMs, share = total > 0 ? r.hostMs / total : 0.0;
+        std::printf("%-10s %14.3f %14.3f %14.3f %7.1f%%\n", r.label.c_str(), total, r.passesMs, r.hostMs, 100 * share);
+        csv << r.label << ',' << total << ',' << r.passesMs << ',' << r.hostMs << ',' << share << '\n';
+    }
+    std::printf("\n(CPU side of Runtime::renderFrame; the frame's wall time, GPU work included, is in kiln-bench-skip)\n");
+    // The guard around each execute() (kiln/guard.hpp) is inside "in passes": timed
+    // here on its own, an empty call guarded against the same call unguarded.
+    const GuardCost g = measureGuard(args.repeats);
+    int passesRun = 0;
+    for (auto& p : outcomes.front().passes) passesRun += p.ran > 0;
+    const double perFrameMs = g.perCallUs * passesRun / 1000.0;
+    const double movingMs = outcomes.front().hostMs + outcomes.front().passesMs;
+    std::printf("guard: %.3f us per guarded call (%.3f us unguarded); %d passes ran per moving frame: %.4f ms, "
+                "%.3f%% of its renderFrame\n", g.perCallUs, g.plainUs, passesRun, perFrameMs,
+                movingMs > 0 ? 100 * perFrameMs / movingMs : 0.0);
+    csv << "guard," << g.perCallUs / 1000.0 * passesRun << ",,," << "\n";
+}
+
+// kiln-bench-skip's table: per situation, every pass's state and times.
+void reportSkip(const std::vector<Outcome>& outcomes, std::ofstream& csv) {
+    csv << "situation,pass,state,gpu_ms,cpu_ms,ran,skipped,frame_ms,frame_ratio\n";
+    const double moving = outcomes.front().frameMs;
+    for (const Outcome& r : outcomes) {
+        std::printf("%s: %.3f ms per frame (%.4f of moving); t = %.3f s, %zu balls, %zu particles\n", r.label.c_str(),
+                    r.frameMs, r.frameMs / moving, r.simTime, r.balls, r.particles);
+        for (auto& p : r.passes) {
+            std::printf("    %-12s %-14s gpu %8.3f  cpu %8.3f  ran %3d  skipped %3d\n", p.id.c_str(), p.state.c_str(),
+                        p.gpuMs, p.cpuMs, p.ran, p.skipped);
+            csv << '"' << r.label << "\"," << p.id << ',' << p.state << ',' << p.gpuMs << ',' << p.cpuMs << ','
+                << p.ran << ',' << p.skipped << ',' << r.frameMs << ',' << r.frameMs / moving << '\n';
+        }
+    }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -189,71 +260,14 @@ int main(int argc, char** argv) {
         situations.push_back({"moving, bloom culled", editedPipeline(pipeline, true, false), o.scene, false});
         situations.push_back({"moving, bloom disabled", editedPipeline(pipeline, false, true), o.scene, false});
     }
-    std::vector<std::vector<Outcome>> rounds(situations.size());
-    // Each round starts one situation later: the situation that follows the fireball-free
-    // scene measured up to 1.3x slower in every pass, whichever it was (a driver state we
-    // have not pinned down), so no situation may always sit in that slot.
-    for (int r = 0; r < args.repeats; ++r)
-        for (size_t k = 0; k < situations.size(); ++k) {
-            const size_t i = (k + size_t(r)) % situations.size();
-            rounds[i].push_back(runSituation(app, situations[i], args.frames));
-        }
-    std::vector<Outcome> outcomes;
-    for (auto& all : rounds) {
-        Outcome o = all.front();
-        auto med = [&](auto get) {
-            std::vector<double> v;
-            for (auto& x : all) v.push_back(get(x));
-            return median(v);
-        };
-        o.frameMs = med([](const Outcome& x) { return x.frameMs; });
-        o.hostMs = med([](const Outcome& x) { return x.hostMs; });
-        o.passesMs = med([](const Outcome& x) { return x.passesMs; });
-        for (size_t p = 0; p < o.passes.size(); ++p) {
-            o.passes[p].gpuMs = med([&](const Outcome& x) { return x.passes[p].gpuMs; });
-            o.passes[p].cpuMs = med([&](const Outcome& x) { return x.passes[p].cpuMs; });
-        }
-        outcomes.push_back(std::move(o));
-    }
+    const std::vector<Outcome> outcomes = measureRounds(app, situations, args);
 
     std::printf("%s: %s, %dx%d, medians of %d frames each over %d rounds, one process\n\n", name,
                 context->description().c_str(), args.width, args.height, args.frames, args.repeats);
     const std::string csvPath = (fs::path(args.outDir) / (overhead ? "overhead.csv" : "skip.csv")).string();
     std::ofstream csv(csvPath);
-    if (overhead) {
-        csv << "situation,frame_cpu_ms,passes_cpu_ms,graph_cpu_ms,graph_share\n";
-        std::printf("%-10s %14s %14s %14s %8s\n", "situation", "renderFrame ms", "in passes ms", "graph's own ms", "share");
-        for (auto& r : outcomes) {
-            const double total = r.hostMs + r.passesMs, share = total > 0 ? r.hostMs / total : 0.0;
-            std::printf("%-10s %14.3f %14.3f %14.3f %7.1f%%\n", r.label.c_str(), total, r.passesMs, r.hostMs, 100 * share);
-            csv << r.label << ',' << total << ',' << r.passesMs << ',' << r.hostMs << ',' << share << '\n';
-        }
-        std::printf("\n(CPU side of Runtime::renderFrame; the frame's wall time, GPU work included, is in kiln-bench-skip)\n");
-        // The guard around each execute() (kiln/guard.hpp) is inside "in passes": timed
-        // here on its own, an empty call guarded against the same call unguarded.
-        const GuardCost g = measureGuard(args.repeats);
-        int passesRun = 0;
-        for (auto& p : outcomes.front().passes) passesRun += p.ran > 0;
-        const double perFrameMs = g.perCallUs * passesRun / 1000.0;
-        const double movingMs = outcomes.front().hostMs + outcomes.front().passesMs;
-        std::printf("guard: %.3f us per guarded call (%.3f us unguarded); %d passes ran per moving frame: %.4f ms, "
-                    "%.3f%% of its renderFrame\n", g.perCallUs, g.plainUs, passesRun, perFrameMs,
-                    movingMs > 0 ? 100 * perFrameMs / movingMs : 0.0);
-        csv << "guard," << g.perCallUs / 1000.0 * passesRun << ",,," << "\n";
-    } else {
-        csv << "situation,pass,state,gpu_ms,cpu_ms,ran,skipped,frame_ms,frame_ratio\n";
-        const double moving = outcomes.front().frameMs;
-        for (auto& r : outcomes) {
-            std::printf("%s: %.3f ms per frame (%.4f of moving); t = %.3f s, %zu balls, %zu particles\n", r.label.c_str(),
-                        r.frameMs, r.frameMs / moving, r.simTime, r.balls, r.particles);
-            for (auto& p : r.passes) {
-                std::printf("    %-12s %-14s gpu %8.3f  cpu %8.3f  ran %3d  skipped %3d\n", p.id.c_str(), p.state.c_str(),
-                            p.gpuMs, p.cpuMs, p.ran, p.skipped);
-                csv << '"' << r.label << "\"," << p.id << ',' << p.state << ',' << p.gpuMs << ',' << p.cpuMs << ','
-                    << p.ran << ',' << p.skipped << ',' << r.frameMs << ',' << r.frameMs / moving << '\n';
-            }
-        }
-    }
+    if (overhead) reportOverhead(outcomes, args, csv);
+    else reportSkip(outcomes, csv);
     std::printf("wrote %s\n", csvPath.c_str());
     return 0;
 }
