@@ -1,5 +1,6 @@
 #include "app/cli.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cstring>
 #include <filesystem>
@@ -81,88 +82,99 @@ std::string usage() {
            "  Kiln was built from); modules from " + KILN_MODULE_DIR + "\n";
 }
 
+namespace {
+
+// Switches: each sets one field.
+struct Switch {
+    std::string_view name;
+    bool Options::*field;
+    bool value;
+};
+constexpr Switch kSwitches[] = {{"--help", &Options::help, true},        {"-h", &Options::help, true},
+                                {"--headless", &Options::headless, true}, {"--stats", &Options::stats, true},
+                                {"--no-live", &Options::live, false},     {"--no-skip", &Options::noSkip, true},
+                                {"--plan", &Options::printPlan, true},    {"--paused", &Options::paused, true}};
+
+// Options whose value is kept as text (paths, a texture name).
+struct TextOption {
+    std::string_view name;
+    std::string Options::*field;
+};
+constexpr TextOption kTextOptions[] = {
+    {"--pipeline", &Options::pipeline}, {"--scene", &Options::scene},     {"--out", &Options::out},
+    {"--dump", &Options::dump},         {"--dot", &Options::dot},         {"--shaders", &Options::shaderRoot},
+    {"--modules", &Options::moduleDir}, {"--view", &Options::view},       {"--screenshot", &Options::screenshot},
+    {"--ui-probe", &Options::uiProbe}};
+
+bool parseSize(const std::string& v, Options& o, std::string& error) {
+    const auto x = v.find('x');
+    long long w = 0, h = 0;
+    if (x == std::string::npos || !parseInt(std::string_view(v).substr(0, x), w) ||
+        !parseInt(std::string_view(v).substr(x + 1), h) || w < 1 || h < 1 || w > 16384 || h > 16384) {
+        error = "--size " + v + ": expected WxH with 1 <= W, H <= 16384 (e.g. 720x720)";
+        return false;
+    }
+    o.width = static_cast<int>(w);
+    o.height = static_cast<int>(h);
+    return true;
+}
+
+// --budget, --watchdog, --frames, --seed: whole numbers, bounded where the value lands
+// (frames in an int, the seed in 63 bits: parseInt's range), so nothing wraps.
+bool parseNumber(std::string_view a, const std::string& v, Options& o, std::string& error) {
+    constexpr long long kMaxFrames = 1'000'000'000;
+    long long n = 0;
+    const bool parsed = parseInt(v, n);
+    if (a == "--budget" || a == "--watchdog") {
+        const bool budget = a == "--budget";
+        const long long most = budget ? 100000 : 86400;
+        if (!parsed || n < 0 || n > most) {
+            error = std::string(a) + " " + v + ": expected " + (budget ? "milliseconds" : "whole seconds") + ", 0 to " +
+                    std::to_string(most) + (budget ? " (0: off)" : " (0: never)");
+            return false;
+        }
+        (budget ? o.budgetMs : o.watchdogSeconds) = static_cast<int>(n);
+    } else if (a == "--frames") {
+        if (!parsed || n < 1 || n > kMaxFrames) {
+            error = std::string(a) + " " + v + ": expected a whole number of frames from 1 to " + std::to_string(kMaxFrames);
+            return false;
+        }
+        o.frames = static_cast<int>(n);
+    } else {
+        if (!parsed || n < 0) {
+            error = std::string(a) + " " + v + ": expected a non-negative integer";
+            return false;
+        }
+        o.seed = static_cast<uint64_t>(n);
+    }
+    return true;
+}
+
+}  // namespace
+
 std::optional<Options> parseOptions(int argc, char** argv, std::string& error) {
     Options o;
     for (int i = 1; i < argc; ++i) {
-        std::string_view a = argv[i];
-        auto value = [&](std::string_view name) -> std::optional<std::string> {
-            if (i + 1 >= argc) {
-                error = std::string(name) + " needs a value";
-                return std::nullopt;
-            }
-            return std::string(argv[++i]);
-        };
-        if (a == "--help" || a == "-h") {
-            o.help = true;
-        } else if (a == "--headless") {
-            o.headless = true;
-        } else if (a == "--stats") {
-            o.stats = true;
-        } else if (a == "--no-live") {
-            o.live = false;
-        } else if (a == "--no-skip") {
-            o.noSkip = true;
-        } else if (a == "--plan") {
-            o.printPlan = true;
-        } else if (a == "--paused") {
-            o.paused = true;
-        } else if (a == "--pipeline" || a == "--scene" || a == "--out" || a == "--dump" || a == "--dot" ||
-                   a == "--shaders" || a == "--modules" || a == "--view" || a == "--screenshot" || a == "--ui-probe") {
-            auto v = value(a);
-            if (!v) return std::nullopt;
-            std::string* dst = a == "--pipeline" ? &o.pipeline
-                             : a == "--scene"    ? &o.scene
-                             : a == "--out"      ? &o.out
-                             : a == "--dump"     ? &o.dump
-                             : a == "--dot"      ? &o.dot
-                             : a == "--shaders"  ? &o.shaderRoot
-                             : a == "--modules"  ? &o.moduleDir
-                             : a == "--screenshot" ? &o.screenshot
-                             : a == "--ui-probe" ? &o.uiProbe
-                                                 : &o.view;
-            *dst = *v;
-        } else if (a == "--size") {
-            auto v = value(a);
-            if (!v) return std::nullopt;
-            auto x = v->find('x');
-            long long w = 0, h = 0;
-            if (x == std::string::npos || !parseInt(std::string_view(*v).substr(0, x), w) ||
-                !parseInt(std::string_view(*v).substr(x + 1), h) || w < 1 || h < 1 || w > 16384 || h > 16384) {
-                error = "--size " + *v + ": expected WxH with 1 <= W, H <= 16384 (e.g. 720x720)";
-                return std::nullopt;
-            }
-            o.width = static_cast<int>(w);
-            o.height = static_cast<int>(h);
-        } else if (a == "--budget" || a == "--watchdog") {
-            auto v = value(a);
-            if (!v) return std::nullopt;
-            const bool budget = a == "--budget";
-            const long long most = budget ? 100000 : 86400;
-            long long n = 0;
-            if (!parseInt(*v, n) || n < 0 || n > most) {
-                error = std::string(a) + " " + *v + ": expected " + (budget ? "milliseconds" : "whole seconds") + ", 0 to " +
-                        std::to_string(most) + (budget ? " (0: off)" : " (0: never)");
-                return std::nullopt;
-            }
-            (budget ? o.budgetMs : o.watchdogSeconds) = static_cast<int>(n);
-        } else if (a == "--frames" || a == "--seed") {
-            auto v = value(a);
-            if (!v) return std::nullopt;
-            long long n = 0;
-            // Bounded where the value lands: frames in an int, the seed in 63 bits (parseInt's
-            // range), so nothing wraps into another number.
-            constexpr long long kMaxFrames = 1'000'000'000;
-            const bool frames = a == "--frames";
-            if (!parseInt(*v, n) || n < (frames ? 1 : 0) || (frames && n > kMaxFrames)) {
-                error = std::string(a) + " " + *v + ": expected " +
-                        (frames ? "a whole number of frames from 1 to " + std::to_string(kMaxFrames) : std::string("a non-negative integer"));
-                return std::nullopt;
-            }
-            if (a == "--frames") o.frames = static_cast<int>(n); else o.seed = static_cast<uint64_t>(n);
-        } else {
+        const std::string_view a = argv[i];
+        const Switch* flag = std::find_if(std::begin(kSwitches), std::end(kSwitches), [&](auto& f) { return f.name == a; });
+        if (flag != std::end(kSwitches)) {
+            o.*(flag->field) = flag->value;
+            continue;
+        }
+        const TextOption* text =
+            std::find_if(std::begin(kTextOptions), std::end(kTextOptions), [&](auto& t) { return t.name == a; });
+        const bool number = a == "--budget" || a == "--watchdog" || a == "--frames" || a == "--seed";
+        if (text == std::end(kTextOptions) && !number && a != "--size") {
             error = "unknown argument \"" + std::string(a) + "\" (see kiln --help)";
             return std::nullopt;
         }
+        if (i + 1 >= argc) {
+            error = std::string(a) + " needs a value";
+            return std::nullopt;
+        }
+        const std::string v = argv[++i];
+        if (text != std::end(kTextOptions)) o.*(text->field) = v;
+        else if (a == "--size" ? !parseSize(v, o, error) : !parseNumber(a, v, o, error)) return std::nullopt;
     }
     return o;
 }
