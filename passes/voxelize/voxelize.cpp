@@ -109,7 +109,15 @@ public:
 
         for (const Sum& sum : kSums) glClearTexImage(ctx.internal(sum.internal).id, 0, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
 
-        // 1–3: rasterise into the sums (no attachments: the fragment shader only does atomics).
+        rasterize(ctx, raster, res, particles && !splatParticles, !splatFireballs);
+        if (splatter && !splat(ctx, splatter, res, splatParticles, splatFireballs)) return;
+        resolveSums(ctx, resolve, out, res);
+    }
+
+private:
+    // 1–3: the box, the tumblers and whatever is not splatted, rasterised into the sums
+    // (no attachments: the fragment shader only does atomics); then the lamp.
+    void rasterize(kiln::PassContext& ctx, GLuint raster, int res, bool rasterParticles, bool rasterFireballs) {
         if (!fbo_) fbo_ = kiln::gl::createFramebuffer();
         if (fboSize_ != res) {
             glNamedFramebufferParameteri(fbo_.id(), GL_FRAMEBUFFER_DEFAULT_WIDTH, res);
@@ -128,8 +136,8 @@ public:
         kiln::gl::bindTexture(raster, "u_shadowMap", ctx.input("shadow_map").id);
         bindSums(ctx, raster, GL_READ_WRITE);
         uint32_t cats = kiln::kSceneBox | kiln::kSceneTumblers;
-        if (!splatFireballs) cats |= kiln::kSceneFireballs;
-        if (particles && !splatParticles) cats |= kiln::kSceneParticles;
+        if (rasterFireballs) cats |= kiln::kSceneFireballs;
+        if (rasterParticles) cats |= kiln::kSceneParticles;
         if (ctx.getBool("marbles")) cats |= kiln::kSceneMarbles;
         const GLint emissionScale = glGetUniformLocation(raster, "u_emissionScale");
         glUniform1f(emissionScale, 1.0f);
@@ -137,33 +145,36 @@ public:
         glUniform1f(emissionScale, ctx.getFloat("lamp_emission"));
         ctx.drawScene({.categories = kiln::kSceneLamp, .lod = kiln::Lod::Low});
         glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    }
 
-        // The fireballs and particles, splatted. They are neighbours in the instance buffer, fireballs first,
-        // so one dispatch covers both: its first u_litCount spheres are lit. (Two
-        // dispatches in a row, with other uniforms, lost most of both on llvmpipe.)
-        if (splatter) {
-            const kiln::SceneView& scene = ctx.scene();
-            const uint32_t fireballs = splatFireballs ? scene.count(kiln::kSceneFireballs) : 0;
-            const uint32_t sparks = splatParticles ? scene.count(kiln::kSceneParticles) : 0;
-            if (scene.firstInstance(kiln::kSceneParticles) !=
-                scene.firstInstance(kiln::kSceneFireballs) + scene.count(kiln::kSceneFireballs))
-                return ctx.fail("the instance buffer no longer holds the particles right after the fireballs");
-            const uint32_t first = scene.firstInstance(splatFireballs ? kiln::kSceneFireballs : kiln::kSceneParticles);
-            const uint32_t count = splatFireballs ? fireballs + sparks : sparks;
-            if (count > 0) {
-                glUseProgram(splatter);
-                kiln::gl::bindTexture(splatter, "u_shadowMap", ctx.input("shadow_map").id);
-                bindSums(ctx, splatter, GL_READ_WRITE);
-                glUniform1i(glGetUniformLocation(splatter, "u_res"), res);
-                glUniform1f(glGetUniformLocation(splatter, "u_shadowBias"), ctx.getFloat("shadow_bias"));
-                glUniform1ui(glGetUniformLocation(splatter, "u_first"), first);
-                glUniform1ui(glGetUniformLocation(splatter, "u_sphereCount"), count);
-                glUniform1ui(glGetUniformLocation(splatter, "u_litCount"), fireballs);
-                glDispatchCompute((count + 63) / 64, 1, 1);
-            }
-        }
+    // The fireballs and particles, splatted. They are neighbours in the instance buffer,
+    // fireballs first, so one dispatch covers both: its first u_litCount spheres are lit.
+    // (Two dispatches in a row, with other uniforms, lost most of both on llvmpipe.)
+    // False when the pass failed.
+    static bool splat(kiln::PassContext& ctx, GLuint splatter, int res, bool splatParticles, bool splatFireballs) {
+        const kiln::SceneView& scene = ctx.scene();
+        const uint32_t fireballs = splatFireballs ? scene.count(kiln::kSceneFireballs) : 0;
+        const uint32_t sparks = splatParticles ? scene.count(kiln::kSceneParticles) : 0;
+        if (scene.firstInstance(kiln::kSceneParticles) !=
+            scene.firstInstance(kiln::kSceneFireballs) + scene.count(kiln::kSceneFireballs))
+            return ctx.fail("the instance buffer no longer holds the particles right after the fireballs"), false;
+        const uint32_t first = scene.firstInstance(splatFireballs ? kiln::kSceneFireballs : kiln::kSceneParticles);
+        const uint32_t count = splatFireballs ? fireballs + sparks : sparks;
+        if (count == 0) return true;
+        glUseProgram(splatter);
+        kiln::gl::bindTexture(splatter, "u_shadowMap", ctx.input("shadow_map").id);
+        bindSums(ctx, splatter, GL_READ_WRITE);
+        glUniform1i(glGetUniformLocation(splatter, "u_res"), res);
+        glUniform1f(glGetUniformLocation(splatter, "u_shadowBias"), ctx.getFloat("shadow_bias"));
+        glUniform1ui(glGetUniformLocation(splatter, "u_first"), first);
+        glUniform1ui(glGetUniformLocation(splatter, "u_sphereCount"), count);
+        glUniform1ui(glGetUniformLocation(splatter, "u_litCount"), fireballs);
+        glDispatchCompute((count + 63) / 64, 1, 1);
+        return true;
+    }
 
-        // 4: resolve the averages.
+    // 4: the sums' averages into the outputs.
+    static void resolveSums(kiln::PassContext& ctx, GLuint resolve, const kiln::TextureRef& out, int res) {
         glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
         glUseProgram(resolve);
         bindSums(ctx, resolve, GL_READ_ONLY);
@@ -174,7 +185,6 @@ public:
         glDispatchCompute(groups, groups, groups);
     }
 
-private:
     // The accumulators: each internal texture and its image in shaders/voxelize/sums.glsl.
     // The normal's are signed: R32UI storage viewed as R32I (same size class).
     struct Sum {
