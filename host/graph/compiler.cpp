@@ -495,25 +495,11 @@ private:
         }
         std::string producerId, outputName;
         if (!splitBinding(text, producerId, outputName)) {
-            std::string hint;
-            auto id = ids_.find(text);
-            if (id != ids_.end() && decls_[static_cast<size_t>(id->second)] &&
-                !decls_[static_cast<size_t>(id->second)]->outputs.empty())
-                hint = " (e.g. " + q(text + "." + decls_[static_cast<size_t>(id->second)]->outputs[0].name) + ")";
-            passError(i, path, "malformed binding " + q(text) + ": expected \"<pass id>.<output>\"" + hint);
+            passError(i, path, "malformed binding " + q(text) + ": expected \"<pass id>.<output>\"" + bindingHint(text));
             return;
         }
-        const int j = lookupPass(producerId, i, path);
+        const int j = producerBefore(i, producerId, text, path);
         if (j < 0) return;
-        if (j == i) {
-            passError(i, path, "input bound to its own pass (" + q(text) + "): a pass cannot read what it writes");
-            return;
-        }
-        if (j > i) {
-            passError(i, path, q(text) + " is produced later in the file: move " + q(producerId) + " (" +
-                                   passPath(j) + ") before " + q(p.id) + " (" + passPath(i) + ")");
-            return;
-        }
         const PassDeclaration* producer = decls_[static_cast<size_t>(j)];
         if (!producer || !in) return;  // already reported against that pass's module
         auto out = std::find_if(producer->outputs.begin(), producer->outputs.end(),
@@ -527,17 +513,9 @@ private:
                                    " is " + describe(*out));
             return;
         }
-        if (const ProducedWhen& when = out->producedWhen; !when.param.empty()) {
-            const std::string* value = plan_.passes[static_cast<size_t>(j)].params.get<std::string>(when.param);
-            if (value && std::find(when.values.begin(), when.values.end(), *value) == when.values.end()) {
-                std::string values;
-                for (size_t k = 0; k < when.values.size(); ++k)
-                    values += (k == 0 ? "" : k + 1 == when.values.size() ? " or " : ", ") + q(when.values[k]);
-                passError(i, path, q(text) + " is filled only when " + q(producerId) + "'s " + when.param + " is " +
-                                       values + "; it is " + q(*value) + " (" + passPath(j) + ".params." +
-                                       when.param + ")");
-                return;
-            }
+        if (std::string unfilled = unfilledOutput(j, *out, text, producerId); !unfilled.empty()) {
+            passError(i, path, unfilled);
+            return;
         }
         Binding& b = *std::find_if(pp.bindings.begin(), pp.bindings.end(),
                                    [&](const Binding& x) { return x.slot == slot; });
@@ -553,6 +531,40 @@ private:
         }
         b.producer = j;
         b.output = outputName;
+    }
+
+    // The index of the pass that produces `text` for pass i, which must come before i;
+    // -1, reported, otherwise.
+    int producerBefore(int i, const std::string& producerId, const std::string& text, const std::string& path) {
+        const int j = lookupPass(producerId, i, path);
+        if (j < 0) return -1;
+        if (j == i)
+            passError(i, path, "input bound to its own pass (" + q(text) + "): a pass cannot read what it writes");
+        else if (j > i)
+            passError(i, path, q(text) + " is produced later in the file: move " + q(producerId) + " (" + passPath(j) +
+                                   ") before " + q(desc_.passes[static_cast<size_t>(i)].id) + " (" + passPath(i) + ")");
+        return j < i ? j : -1;
+    }
+
+    // ' (e.g. "gbuffer.albedo")' when a binding names a pass without an output.
+    std::string bindingHint(const std::string& text) const {
+        auto id = ids_.find(text);
+        if (id == ids_.end()) return "";
+        const PassDeclaration* d = decls_[static_cast<size_t>(id->second)];
+        return d && !d->outputs.empty() ? " (e.g. " + q(text + "." + d->outputs[0].name) + ")" : "";
+    }
+
+    // Why output `out` of pass j is not filled with j's parameters (producedWhen), or "".
+    std::string unfilledOutput(int j, const TextureDecl& out, const std::string& text, const std::string& producerId) const {
+        const ProducedWhen& when = out.producedWhen;
+        if (when.param.empty()) return "";
+        const std::string* value = plan_.passes[static_cast<size_t>(j)].params.get<std::string>(when.param);
+        if (!value || std::find(when.values.begin(), when.values.end(), *value) != when.values.end()) return "";
+        std::string values;
+        for (size_t k = 0; k < when.values.size(); ++k)
+            values += (k == 0 ? "" : k + 1 == when.values.size() ? " or " : ", ") + q(when.values[k]);
+        return q(text) + " is filled only when " + q(producerId) + "'s " + when.param + " is " + values + "; it is " +
+               q(*value) + " (" + passPath(j) + ".params." + when.param + ")";
     }
 
     // ' (e.g. "gbuffer.depth")': earlier enabled outputs of the right kind.
