@@ -52,6 +52,32 @@ void followBudget(WindowState& state, double now) {
     }
 }
 
+// What the command line asks of the window at start.
+void startState(WindowState& state, const Options& o, App& app) {
+    state.app = &app;
+    state.probe.path = o.uiProbe;
+    state.mainShowsSelection = !o.view.empty();
+    state.showTexture = !o.view.empty();
+    state.compare.on = fs::path(o.pipeline).filename() == "compare.json";
+    state.autoScale = o.budgetMs > 0;
+    state.budgetMs = o.budgetMs > 0 ? float(o.budgetMs) : state.budgetMs;
+    std::string error;
+    if (!state.viewer.init(app.runtime().shaders(), error)) log::error(error);
+}
+
+// The debug view over the image: the sidebar's panels and the error overlay.
+void drawUi(WindowState& state, int fbW, int fbH) {
+    ImGui_ImplOpenGL3_NewFrame();
+    ImGui_ImplGlfw_NewFrame();
+    ImGui::NewFrame();
+    if (state.showDebug) drawSidebar(state);
+    panelErrors(*state.app, state);
+    ImGui::Render();
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glViewport(0, 0, fbW, fbH);
+    ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+}
+
 }  // namespace
 
 int runWindow(const Options& o) {
@@ -69,14 +95,7 @@ int runWindow(const Options& o) {
         return 1;
     }
     WindowState state;
-    state.app = &app;
-    state.probe.path = o.uiProbe;
-    state.mainShowsSelection = !o.view.empty();
-    state.showTexture = !o.view.empty();
-    state.compare.on = fs::path(o.pipeline).filename() == "compare.json";
-    state.autoScale = o.budgetMs > 0;
-    state.budgetMs = o.budgetMs > 0 ? float(o.budgetMs) : state.budgetMs;
-    if (!state.viewer.init(app.runtime().shaders(), error)) log::error(error);
+    startState(state, o, app);
     GLFWwindow* window = context->window();
     glfwSetWindowUserPointer(window, &state);
     installCallbacks(window);
@@ -108,15 +127,7 @@ int runWindow(const Options& o) {
         app.frame(frames == 1 ? -1.0 : wall);
         drawImage(state, fbW, fbH);
 
-        ImGui_ImplOpenGL3_NewFrame();
-        ImGui_ImplGlfw_NewFrame();
-        ImGui::NewFrame();
-        if (state.showDebug) drawSidebar(state);
-        panelErrors(app, state);
-        ImGui::Render();
-        glBindFramebuffer(GL_FRAMEBUFFER, 0);
-        glViewport(0, 0, fbW, fbH);
-        ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+        drawUi(state, fbW, fbH);
         state.probe.write(probeState(state, uint64_t(frames)));
         if (!o.screenshot.empty() && frames == o.frames) {
             saveScreenshot(o.screenshot, fbW, fbH);
