@@ -118,37 +118,7 @@ void FileWatcher::rescan() {
 
 std::vector<fs::path> FileWatcher::poll() {
     if (fd_ >= 0) {
-        alignas(inotify_event) char buf[16384];
-        for (;;) {
-            ssize_t n = ::read(fd_, buf, sizeof buf);
-            if (n <= 0) break;
-            for (char* p = buf; p < buf + n;) {
-                auto* e = reinterpret_cast<inotify_event*>(p);
-                p += sizeof(inotify_event) + e->len;
-                if (e->mask & IN_Q_OVERFLOW) {
-                    log::warn("file watcher: event queue overflowed; rescanning");
-                    rescan();
-                    continue;
-                }
-                auto dir = watches_.find(e->wd);
-                if (dir == watches_.end()) continue;
-                if (e->mask & (IN_DELETE_SELF | IN_MOVE_SELF | IN_IGNORED)) {
-                    watches_.erase(dir);  // gone: re-added if it comes back (IN_CREATE on the parent)
-                    continue;
-                }
-                if (e->len == 0) continue;
-                const fs::path path = dir->second / e->name;
-                if (e->mask & IN_ISDIR) {
-                    if (e->mask & (IN_CREATE | IN_MOVED_TO)) {
-                        addDirectory(path);
-                        rescan();  // files written before the watch existed
-                    }
-                    continue;
-                }
-                // IN_CREATE alone may be a half-written file: wait for CLOSE_WRITE.
-                if (e->mask & (IN_CLOSE_WRITE | IN_MOVED_TO)) noteEvent(path);
-            }
-        }
+        readEvents();
         // A root has no parent watch to announce its return (shaders/ deleted and
         // checked out again): look for it while it is gone.
         if (Clock::now() - lastRootCheck_ > std::chrono::milliseconds(250)) {
@@ -164,7 +134,44 @@ std::vector<fs::path> FileWatcher::poll() {
         lastScan_ = Clock::now();
         rescan();
     }
+    return settledChanges();
+}
 
+void FileWatcher::readEvents() {
+    alignas(inotify_event) char buf[16384];
+    for (;;) {
+        const ssize_t n = ::read(fd_, buf, sizeof buf);
+        if (n <= 0) return;
+        for (char* p = buf; p < buf + n;) {
+            auto* e = reinterpret_cast<inotify_event*>(p);
+            p += sizeof(inotify_event) + e->len;
+            if (e->mask & IN_Q_OVERFLOW) {
+                log::warn("file watcher: event queue overflowed; rescanning");
+                rescan();
+                continue;
+            }
+            auto dir = watches_.find(e->wd);
+            if (dir == watches_.end()) continue;
+            if (e->mask & (IN_DELETE_SELF | IN_MOVE_SELF | IN_IGNORED)) {
+                watches_.erase(dir);  // gone: re-added if it comes back (IN_CREATE on the parent)
+                continue;
+            }
+            if (e->len == 0) continue;
+            const fs::path path = dir->second / e->name;
+            if (e->mask & IN_ISDIR) {
+                if (e->mask & (IN_CREATE | IN_MOVED_TO)) {
+                    addDirectory(path);
+                    rescan();  // files written before the watch existed
+                }
+                continue;
+            }
+            // IN_CREATE alone may be a half-written file: wait for CLOSE_WRITE.
+            if (e->mask & (IN_CLOSE_WRITE | IN_MOVED_TO)) noteEvent(path);
+        }
+    }
+}
+
+std::vector<fs::path> FileWatcher::settledChanges() {
     std::vector<fs::path> settled;
     const auto now = Clock::now();
     for (auto it = pending_.begin(); it != pending_.end();) {

@@ -48,6 +48,9 @@ private:
     void addDirectory(const std::filesystem::path& dir, bool firstSight = true);
     bool isWatched(const std::filesystem::path& dir) const;
     void noteEvent(const std::filesystem::path& file);
+    void readEvents();  // drains inotify without blocking
+    // Pending paths quiet for the debounce interval whose content changed.
+    std::vector<std::filesystem::path> settledChanges();
     void rescan();
     static bool isNoise(const std::string& name);
 
