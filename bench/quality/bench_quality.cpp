@@ -349,6 +349,38 @@ struct Result {
     bool pareto = false;
 };
 
+// Every pixel counted but those showing an emitter (nonzero G-buffer emission).
+metrics::Mask emittersMasked(const FloatImage& glow) {
+    metrics::Mask mask(size_t(glow.width) * glow.height, 1);
+    for (int y = 0; y < glow.height; ++y)
+        for (int x = 0; x < glow.width; ++x) {
+            const float* e = glow.at(x, y);
+            if (e[0] + e[1] + e[2] > 0.0f) mask[size_t(y) * glow.width + x] = 0;
+        }
+    return mask;
+}
+
+// The ceiling around the dome: its pixels, corrected relMSE, the reference's noise there
+// and the mean light over the reference's.
+void domeRingFigures(const FloatImage& image, const Reference& ref, const metrics::Mask& ring, Result& r) {
+    r.ringPixels = int(std::count(ring.begin(), ring.end(), 1));
+    if (r.ringPixels == 0) return;
+    r.ringRelMseCorrected = metrics::noiseCorrectedRelativeMse(image, ref.halves[0], ref.halves[1], ring);
+    r.ringNoise = metrics::referenceNoiseRelativeMse(ref.halves[0], ref.halves[1], ring);
+    r.ringRatio = metrics::meanLuminanceRatio(image, ref.halves[0], ref.halves[1], ring);
+}
+
+// The indirect part's errors and bias per region (image less the frame without it).
+void indirectFigures(const FloatImage& indirect, const Reference& ref, const metrics::Mask& mask,
+                     const std::vector<metrics::Mask>& partMask, Result& r) {
+    const FloatImage& indirectA = ref.halvesIndirect[0];
+    const FloatImage& indirectB = ref.halvesIndirect[1];
+    r.indirectRelMse = metrics::relativeMse(indirect, ref.meanIndirect, mask);
+    r.indirectRelMseCorrected = metrics::noiseCorrectedRelativeMse(indirect, indirectA, indirectB, mask);
+    for (int p = 0; p < kPartCount; ++p)
+        r.indirectRatio[p] = metrics::meanLuminanceRatio(indirect, indirectA, indirectB, partMask[p]);
+}
+
 bool measure(app::App& app, const Args& args, const Setting& setting, const Reference& ref, Result& r) {
     std::string text, error;
     const std::string& pipeline = setting.pipeline.empty() ? args.pipeline : setting.pipeline;
@@ -374,13 +406,8 @@ bool measure(app::App& app, const Args& args, const Setting& setting, const Refe
     const TextureRef* emissive = app.runtime().findTexture("gbuffer", "emissive");
     if (!hdr || !emissive) return fail(setting.label + ": the pipeline has no composite.hdr / gbuffer.emissive");
     const FloatImage image = readTexture(hdr->id, hdr->target, hdr->format, hdr->width, hdr->height);
-    const FloatImage glow = readTexture(emissive->id, emissive->target, emissive->format, emissive->width, emissive->height);
-    metrics::Mask mask(size_t(image.width) * image.height, 1);
-    for (int y = 0; y < image.height; ++y)
-        for (int x = 0; x < image.width; ++x) {
-            const float* e = glow.at(x, y);
-            if (e[0] + e[1] + e[2] > 0.0f) mask[size_t(y) * image.width + x] = 0;
-        }
+    const metrics::Mask mask =
+        emittersMasked(readTexture(emissive->id, emissive->target, emissive->format, emissive->width, emissive->height));
     const FloatImage& halfA = ref.halves[0];
     const FloatImage& halfB = ref.halves[1];
     r.errors = metrics::compare(image, ref.mean, mask);
@@ -392,12 +419,7 @@ bool measure(app::App& app, const Args& args, const Setting& setting, const Refe
     const std::vector<int> region =
         regionsOf(app, readTexture(depth->id, depth->target, depth->format, depth->width, depth->height), ring);
     for (size_t i = 0; i < ring.size(); ++i) ring[i] = ring[i] && mask[i];
-    r.ringPixels = int(std::count(ring.begin(), ring.end(), 1));
-    if (r.ringPixels > 0) {
-        r.ringRelMseCorrected = metrics::noiseCorrectedRelativeMse(image, halfA, halfB, ring);
-        r.ringNoise = metrics::referenceNoiseRelativeMse(halfA, halfB, ring);
-        r.ringRatio = metrics::meanLuminanceRatio(image, halfA, halfB, ring);
-    }
+    domeRingFigures(image, ref, ring, r);
     std::vector<metrics::Mask> partMask(kPartCount, mask);
     for (int k = 0; k < kRegionCount; ++k) {
         metrics::Mask& m = partMask[1 + k];
@@ -409,14 +431,9 @@ bool measure(app::App& app, const Args& args, const Setting& setting, const Refe
     if (!app.runtime().setParam("composite", "indirect_strength", 0.0f, error)) return fail(setting.label + ": " + error);
     app.frame();
     glFinish();
-    const FloatImage indirect = metrics::difference(image, readTexture(hdr->id, hdr->target, hdr->format, hdr->width, hdr->height));
-    const FloatImage& indirectA = ref.halvesIndirect[0];
-    const FloatImage& indirectB = ref.halvesIndirect[1];
-    r.indirectRelMse = metrics::relativeMse(indirect, ref.meanIndirect, mask);
-    r.indirectRelMseCorrected = metrics::noiseCorrectedRelativeMse(indirect, indirectA, indirectB, mask);
-    for (int p = 0; p < kPartCount; ++p)
-        r.indirectRatio[p] = metrics::meanLuminanceRatio(indirect, indirectA, indirectB, partMask[p]);
-    r.counted = std::move(mask);
+    indirectFigures(metrics::difference(image, readTexture(hdr->id, hdr->target, hdr->format, hdr->width, hdr->height)),
+                    ref, mask, partMask, r);
+    r.counted = mask;
     // The ratios may be NaN (a region out of view): they are printed as n/a, not checked.
     for (double v : {r.errors.rmse, r.errors.relMse, r.errors.ssim, r.relMseCorrected, r.indirectRelMse, r.indirectRelMseCorrected})
         if (!std::isfinite(v)) return fail(setting.label + ": an error metric is not finite");
