@@ -369,6 +369,34 @@ private:
         }
     }
 
+    // An int literal within the declaration's range and, if it lists them, its choices.
+    static std::optional<ParamValue> convertInt(const ParamLiteral& l, const ParamDecl& d, std::string& problem) {
+        const bool ranged = d.min != d.max;
+        if (l.i < INT_MIN || l.i > INT_MAX || (ranged && (l.i < d.min || l.i > d.max))) {
+            problem = "out of range: " + l.text + " is not in " +
+                      (ranged ? "[" + num(d.min) + ", " + num(d.max) + "]"
+                              : "[" + std::to_string(INT_MIN) + ", " + std::to_string(INT_MAX) + "]");
+            return std::nullopt;
+        }
+        const int v = static_cast<int>(l.i);
+        if (!d.intChoices.empty() && std::find(d.intChoices.begin(), d.intChoices.end(), v) == d.intChoices.end()) {
+            problem = l.text + " is not one of the allowed values ";
+            for (size_t k = 0; k < d.intChoices.size(); ++k) problem += (k ? ", " : "") + std::to_string(d.intChoices[k]);
+            return std::nullopt;
+        }
+        return ParamValue(v);
+    }
+
+    // A string literal that is one of the enum's choices (else the nearest is suggested).
+    static std::optional<ParamValue> convertEnum(const ParamLiteral& l, const ParamDecl& d, std::string& problem) {
+        if (std::find(d.choices.begin(), d.choices.end(), l.s) != d.choices.end()) return ParamValue(l.s);
+        const std::string near = nearestName(l.s, d.choices);
+        problem = q(l.s) + " is not one of ";
+        for (size_t k = 0; k < d.choices.size(); ++k) problem += (k ? ", " : "") + q(d.choices[k]);
+        if (!near.empty()) problem += " (did you mean " + q(near) + "?)";
+        return std::nullopt;
+    }
+
     static std::optional<ParamValue> convert(const ParamLiteral& l, const ParamDecl& d, std::string& problem) {
         using T = ParamLiteral::Type;
         auto wrongType = [&](const std::string& expected) {
@@ -383,22 +411,9 @@ private:
             case ParamType::Bool:
                 if (l.type != T::Bool) return wrongType("bool");
                 return ParamValue(l.b);
-            case ParamType::Int: {
+            case ParamType::Int:
                 if (l.type != T::Int) return wrongType("int");
-                if (l.i < INT_MIN || l.i > INT_MAX || (ranged && (l.i < d.min || l.i > d.max))) {
-                    problem = "out of range: " + l.text + " is not in " +
-                              (ranged ? range() : "[" + std::to_string(INT_MIN) + ", " + std::to_string(INT_MAX) + "]");
-                    return std::nullopt;
-                }
-                const int v = static_cast<int>(l.i);
-                if (!d.intChoices.empty() && std::find(d.intChoices.begin(), d.intChoices.end(), v) == d.intChoices.end()) {
-                    problem = l.text + " is not one of the allowed values ";
-                    for (size_t k = 0; k < d.intChoices.size(); ++k)
-                        problem += (k ? ", " : "") + std::to_string(d.intChoices[k]);
-                    return std::nullopt;
-                }
-                return ParamValue(v);
-            }
+                return convertInt(l, d, problem);
             case ParamType::Float: {
                 if (l.type != T::Float && l.type != T::Int) return wrongType("float");
                 if (!std::isfinite(l.f) || (ranged && (l.f < d.min || l.f > d.max))) {
@@ -407,17 +422,9 @@ private:
                 }
                 return ParamValue(static_cast<float>(l.f));
             }
-            case ParamType::Enum: {
+            case ParamType::Enum:
                 if (l.type != T::String) return wrongType("string (one of the enum's choices)");
-                if (std::find(d.choices.begin(), d.choices.end(), l.s) == d.choices.end()) {
-                    std::string near = nearestName(l.s, d.choices);
-                    problem = q(l.s) + " is not one of ";
-                    for (size_t k = 0; k < d.choices.size(); ++k) problem += (k ? ", " : "") + q(d.choices[k]);
-                    if (!near.empty()) problem += " (did you mean " + q(near) + "?)";
-                    return std::nullopt;
-                }
-                return ParamValue(l.s);
-            }
+                return convertEnum(l, d, problem);
             case ParamType::Color: {
                 const bool ok = l.type == T::Array && l.items.size() == 3 &&
                                 std::all_of(l.items.begin(), l.items.end(), [](const ParamLiteral& e) {
