@@ -149,14 +149,29 @@ struct Preprocessor {
         out.lines.push_back({file, lineNo});
     }
 
+    // "a.frag -> b.glsl -> a.frag": the include stack and `file`.
+    std::string chainTo(const fs::path& file) const {
+        std::string chain;
+        for (auto& f : stack) chain += lib.displayPath(f) + " -> ";
+        return chain + lib.displayPath(file);
+    }
+
+    // What `#include "name"` in `file` reads: beside `file` when that stays inside a
+    // shader root, else the first root that has it; empty when none does.
+    fs::path includeTarget(const fs::path& file, const std::string& name) const {
+        std::error_code ec;
+        const fs::path local = fs::weakly_canonical(file.parent_path() / name, ec);
+        bool insideRoots = false;
+        for (auto& r : lib.roots()) insideRoots |= isInside(r, local);
+        if (!ec && insideRoots && fs::is_regular_file(local, ec)) return local;
+        return lib.resolve(name);
+    }
+
     // Appends `file` to out.text; `header` (the #version + defines) goes right after
     // the #version line of the top-level file.
     bool include(const fs::path& file, const std::string* header) {
         if (std::find(stack.begin(), stack.end(), file) != stack.end()) {
-            std::string chain;
-            for (auto& f : stack) chain += lib.displayPath(f) + " -> ";
-            chain += lib.displayPath(file);
-            error = {lib.displayPath(stack.back()), 0, "#include cycle: " + chain};
+            error = {lib.displayPath(stack.back()), 0, "#include cycle: " + chainTo(file)};
             return false;
         }
         if (std::find(out.dependencies.begin(), out.dependencies.end(), file) != out.dependencies.end())
@@ -191,15 +206,7 @@ struct Preprocessor {
                     error = {lib.displayPath(file), lineNo, "malformed #include (expected #include \"file\")"};
                     return false;
                 }
-                fs::path target;
-                std::error_code ec;
-                fs::path local = fs::weakly_canonical(file.parent_path() / name, ec);
-                bool insideRoots = false;
-                for (auto& r : lib.roots()) insideRoots |= isInside(r, local);
-                if (!ec && insideRoots && fs::is_regular_file(local, ec))
-                    target = local;
-                else
-                    target = lib.resolve(name);
+                const fs::path target = includeTarget(file, name);
                 if (target.empty()) {
                     error = {lib.displayPath(file), lineNo, "#include \"" + elide(name) + "\": file not found in the shader roots"};
                     return false;
