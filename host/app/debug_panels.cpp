@@ -268,6 +268,51 @@ void panelScene(WindowState& state) {
     ImGui::TextDisabled("drag a tumbler: low to move it, high to tilt it");
 }
 
+// Where each pass sits in the graph view: columns by dependency depth (file order is
+// execution order, so producers come first), rows in file order within a column.
+struct GraphLayout {
+    std::vector<int> column, row;
+    int columns = 1;
+};
+
+GraphLayout layOut(const graph::Plan& plan) {
+    const size_t n = plan.passes.size();
+    GraphLayout l{std::vector<int>(n, 0), std::vector<int>(n, 0), 1};
+    for (size_t i = 0; i < n; ++i)
+        for (const graph::Binding& b : plan.passes[i].bindings)
+            if (b.bound()) l.column[i] = std::max(l.column[i], l.column[size_t(b.producer)] + 1);
+    std::map<int, int> rowsInColumn;
+    for (size_t i = 0; i < n; ++i) l.row[i] = rowsInColumn[l.column[i]]++;
+    if (n) l.columns = *std::max_element(l.column.begin(), l.column.end()) + 1;
+    return l;
+}
+
+// One pass's node: its state's colour, its id and module; a click selects it.
+void drawNode(WindowState& state, const graph::PlannedPass& p, const std::string& runState, ImVec2 a, ImVec2 size, int i) {
+    ImDrawList* draw = ImGui::GetWindowDrawList();
+    const ImVec2 b(a.x + size.x, a.y + size.y);
+    // ran this frame: green; skipped (nothing it reads changed): blue; culled: grey;
+    // disabled: dark red; failed or faulted this frame: orange.
+    const ImU32 fill = p.state == graph::PassState::Disabled ? IM_COL32(110, 40, 40, 255)
+                       : p.state == graph::PassState::Culled ? IM_COL32(70, 70, 70, 255)
+                       : runState == "error"                 ? IM_COL32(170, 90, 20, 255)
+                       : runState == "ran" || runState == "nothing to do" ? IM_COL32(40, 110, 60, 255)
+                                                             : IM_COL32(40, 70, 120, 255);
+    draw->AddRectFilled(a, b, fill, 4.0f);
+    if (p.id == state.editor.selected) draw->AddRect(a, b, IM_COL32(255, 220, 80, 255), 4.0f, 0, 2.0f);
+    draw->PushClipRect(a, b, true);  // a narrow node cuts its labels, not its neighbours
+    draw->AddText(ImVec2(a.x + 6, a.y + 4), IM_COL32_WHITE, p.id.c_str());
+    const std::string sub = p.module + " - " + (runState == "error" ? std::string("error") : toString(p.state));
+    draw->AddText(ImVec2(a.x + 6, a.y + 24), IM_COL32(210, 210, 210, 255), sub.c_str());
+    draw->PopClipRect();
+    ImGui::SetCursorScreenPos(a);
+    ImGui::PushID(i);
+    if (ImGui::InvisibleButton("node", size)) state.editor.selected = p.id;
+    if (ImGui::IsItemHovered() && !p.reason.empty()) ImGui::SetTooltip("%s", p.reason.c_str());
+    state.probe.item("graph-node:" + p.id);
+    ImGui::PopID();
+}
+
 // Passes as nodes in columns by dependency depth, bindings as edges.
 void panelGraph(WindowState& state, bool* open) {
     App& app = *state.app;
@@ -283,55 +328,30 @@ void panelGraph(WindowState& state, bool* open) {
         ImGui::End();
         return;
     }
-    const size_t n = plan->passes.size();
-    std::vector<int> column(n, 0), row(n, 0);
-    for (size_t i = 0; i < n; ++i)  // file order is execution order: producers come first
-        for (const graph::Binding& b : plan->passes[i].bindings)
-            if (b.bound()) column[i] = std::max(column[i], column[size_t(b.producer)] + 1);
-    std::map<int, int> rowsInColumn;
-    for (size_t i = 0; i < n; ++i) row[i] = rowsInColumn[column[i]]++;
-    std::map<std::string, bool> ran;
-    for (auto& r : app.runtime().stats()) ran[r.id] = r.ranThisFrame;
+    const GraphLayout layout = layOut(*plan);
+    std::map<std::string, std::string> runState;
+    for (auto& r : app.runtime().stats()) runState[r.id] = r.state;
 
-    ImGui::TextWrapped("green ran, blue skipped (nothing it reads changed), grey culled, red disabled; click to select");
-    const int columns = n ? *std::max_element(column.begin(), column.end()) + 1 : 1;
-    const float perColumn = (ImGui::GetContentRegionAvail().x - 16) / float(columns);
+    ImGui::TextWrapped("green ran, blue skipped (nothing it reads changed), grey culled, red disabled, orange failed; "
+                       "click to select");
+    const float perColumn = (ImGui::GetContentRegionAvail().x - 16) / float(layout.columns);
     const float nodeWidth = std::clamp(perColumn * 0.78f, 90.0f, 150.0f);
     const ImVec2 nodeSize(nodeWidth, 46), gap(std::max(16.0f, std::min(60.0f, perColumn - nodeWidth)), 18);
     const ImVec2 origin = ImGui::GetCursorScreenPos();
     auto nodePos = [&](size_t i) {
-        return ImVec2(origin.x + 8 + column[i] * (nodeSize.x + gap.x), origin.y + 8 + row[i] * (nodeSize.y + gap.y));
+        return ImVec2(origin.x + 8 + layout.column[i] * (nodeSize.x + gap.x),
+                      origin.y + 8 + layout.row[i] * (nodeSize.y + gap.y));
     };
     ImDrawList* draw = ImGui::GetWindowDrawList();
-    for (size_t i = 0; i < n; ++i)
+    for (size_t i = 0; i < plan->passes.size(); ++i)
         for (const graph::Binding& b : plan->passes[i].bindings) {
             if (!b.bound()) continue;
             const ImVec2 a = nodePos(size_t(b.producer)), c = nodePos(i);
             const ImVec2 from(a.x + nodeSize.x, a.y + nodeSize.y * 0.5f), to(c.x, c.y + nodeSize.y * 0.5f);
             draw->AddBezierCubic(from, ImVec2(from.x + 30, from.y), ImVec2(to.x - 30, to.y), to, IM_COL32(180, 180, 190, 200), 1.5f);
         }
-    for (size_t i = 0; i < n; ++i) {
-        const graph::PlannedPass& p = plan->passes[i];
-        const ImVec2 a = nodePos(i), b(a.x + nodeSize.x, a.y + nodeSize.y);
-        // run this frame: green; skipped (nothing it reads changed): blue; culled: grey; disabled: red.
-        ImU32 fill = p.state == graph::PassState::Disabled ? IM_COL32(110, 40, 40, 255)
-                     : p.state == graph::PassState::Culled ? IM_COL32(70, 70, 70, 255)
-                     : ran[p.id]                           ? IM_COL32(40, 110, 60, 255)
-                                                           : IM_COL32(40, 70, 120, 255);
-        draw->AddRectFilled(a, b, fill, 4.0f);
-        if (p.id == state.editor.selected) draw->AddRect(a, b, IM_COL32(255, 220, 80, 255), 4.0f, 0, 2.0f);
-        draw->PushClipRect(a, b, true);  // a narrow node cuts its labels, not its neighbours
-        draw->AddText(ImVec2(a.x + 6, a.y + 4), IM_COL32_WHITE, p.id.c_str());
-        const std::string sub = p.module + " - " + toString(p.state);
-        draw->AddText(ImVec2(a.x + 6, a.y + 24), IM_COL32(210, 210, 210, 255), sub.c_str());
-        draw->PopClipRect();
-        ImGui::SetCursorScreenPos(a);
-        ImGui::PushID(int(i));
-        if (ImGui::InvisibleButton("node", nodeSize)) state.editor.selected = p.id;
-        if (ImGui::IsItemHovered() && !p.reason.empty()) ImGui::SetTooltip("%s", p.reason.c_str());
-        state.probe.item("graph-node:" + p.id);
-        ImGui::PopID();
-    }
+    for (size_t i = 0; i < plan->passes.size(); ++i)
+        drawNode(state, plan->passes[i], runState[plan->passes[i].id], nodePos(i), nodeSize, int(i));
     ImGui::End();
 }
 

@@ -215,32 +215,38 @@ std::string describeSize(const TextureDecl& t, const ResolvedParams& params) {
 
 // ---- printing ----------------------------------------------------------------------
 
+namespace {
+
+// One pass's row of the table: column → lines (several inputs or outputs take a line each).
+std::vector<std::vector<std::string>> tableRow(const std::vector<PlannedPass>& passes, size_t i) {
+    const PlannedPass& p = passes[i];
+    std::string state = toString(p.state);
+    if (!p.reason.empty()) state += ": " + p.reason;
+    std::vector<std::string> inputs, outputs;
+    for (const Binding& b : p.bindings) {
+        if (b.bound()) {
+            inputs.push_back(b.slot + "←" + passes[static_cast<size_t>(b.producer)].id + "." + b.output);
+        } else {
+            std::string s = b.slot + "←fallback:" + toString(b.fallback);
+            if (!b.lost.empty()) s += " (" + b.lost + " disabled)";
+            inputs.push_back(s);
+        }
+    }
+    for (const TextureDecl& t : p.decl.outputs)
+        outputs.push_back(t.name + " " + toString(t.format) + " " + describeSize(t, p.params));
+    for (const TextureDecl& t : p.decl.internals)
+        outputs.push_back(t.name + " " + toString(t.format) + " " + describeSize(t, p.params) + " internal");
+    if (inputs.empty()) inputs.push_back("-");
+    if (outputs.empty()) outputs.push_back("-");
+    return {{std::to_string(i)}, {p.id}, {p.module}, {state}, inputs, outputs};
+}
+
+}  // namespace
+
 std::string Plan::table() const {
-    // One row per pass; a pass with several inputs/outputs continues on extra lines.
     std::vector<std::vector<std::vector<std::string>>> rows;  // pass → column → lines
     const std::vector<std::string> header = {"#", "id", "module", "state", "inputs", "outputs"};
-    for (size_t i = 0; i < passes.size(); ++i) {
-        const PlannedPass& p = passes[i];
-        std::string state = toString(p.state);
-        if (!p.reason.empty()) state += ": " + p.reason;
-        std::vector<std::string> inputs, outputs;
-        for (const Binding& b : p.bindings) {
-            if (b.bound()) {
-                inputs.push_back(b.slot + "←" + passes[static_cast<size_t>(b.producer)].id + "." + b.output);
-            } else {
-                std::string s = b.slot + "←fallback:" + toString(b.fallback);
-                if (!b.lost.empty()) s += " (" + b.lost + " disabled)";
-                inputs.push_back(s);
-            }
-        }
-        for (const TextureDecl& t : p.decl.outputs)
-            outputs.push_back(t.name + " " + toString(t.format) + " " + describeSize(t, p.params));
-        for (const TextureDecl& t : p.decl.internals)
-            outputs.push_back(t.name + " " + toString(t.format) + " " + describeSize(t, p.params) + " internal");
-        if (inputs.empty()) inputs.push_back("-");
-        if (outputs.empty()) outputs.push_back("-");
-        rows.push_back({{std::to_string(i)}, {p.id}, {p.module}, {state}, inputs, outputs});
-    }
+    for (size_t i = 0; i < passes.size(); ++i) rows.push_back(tableRow(passes, i));
 
     std::vector<size_t> width(header.size());
     for (size_t c = 0; c < header.size(); ++c) width[c] = displayWidth(header[c]);
