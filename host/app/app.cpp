@@ -5,6 +5,7 @@
 #include <malloc.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 
 #include "kiln/log.hpp"
@@ -122,34 +123,48 @@ SceneView App::buildView() {
     return v;
 }
 
+// Fixed steps for `wallSeconds` of wall clock × timeScale, while stepping fits in the
+// budget; what it cannot step in time is dropped and counted.
+int App::stepRealTime(double wallSeconds, std::chrono::steady_clock::time_point start) {
+    const double dt = scene_.dt();
+    accumulator_ += std::max(0.0, wallSeconds) * std::max(0.0, timeScale);
+    int steps = 0;
+    while (accumulator_ >= dt) {
+        if (steps > 0 && std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count() >
+                             stepBudgetMs) {
+            const double behind = std::floor(accumulator_ / dt) * dt;
+            droppedSeconds += behind;
+            accumulator_ -= behind;
+            break;
+        }
+        scene_.step();
+        accumulator_ -= dt;
+        ++steps;
+    }
+    return steps;
+}
+
 void App::frame(double wallSeconds) {
     live_.poll(*this);  // edits land at a frame boundary, on this thread
     if (viewed != requestedView_) {
         requestedView_ = viewed;
         runtime_.setRequested(viewed.empty() ? std::vector<std::string>{} : std::vector<std::string>{viewed});
     }
+    if (scene_.time() < lastSimTime_) droppedSeconds = 0.0;  // reset (R) or a reloaded scene
+    const auto stepStart = std::chrono::steady_clock::now();
     int steps = 0;
-    if (singleStep) {
+    if (singleStep || (!paused && wallSeconds < 0.0)) {
+        scene_.step();
         steps = 1;
     } else if (!paused) {
-        if (wallSeconds < 0.0) {
-            steps = 1;
-        } else {
-            const double dt = scene_.dt();
-            accumulator_ += std::max(0.0, wallSeconds) * std::max(0.0, timeScale);
-            steps = int(std::floor(accumulator_ / dt));
-            accumulator_ -= steps * dt;
-            if (steps > kMaxStepsPerFrame) {
-                droppedSeconds += (steps - kMaxStepsPerFrame) * dt;
-                steps = kMaxStepsPerFrame;
-            }
-        }
+        steps = stepRealTime(wallSeconds, stepStart);
     }
     if (paused) accumulator_ = 0.0;
     singleStep = false;
-    for (int i = 0; i < steps; ++i) scene_.step();
     if (steps > 0) ++timeVersion_;
     lastSteps = steps;
+    lastStepMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - stepStart).count();
+    lastSimTime_ = scene_.time();
     const SceneView view = buildView();
     FrameInfo info;
     info.index = frameIndex_++;

@@ -253,9 +253,12 @@ void panelScene(WindowState& state) {
     if (ImGui::SliderFloat("time scale", &scale, 0.05f, 4.0f, "%.2fx", ImGuiSliderFlags_Logarithmic)) app.timeScale = scale;
     ImGui::Text("t = %.2f s, %d steps this frame, %zu balls, %zu particles", app.scene().time(), app.lastSteps,
                 sim.balls().size(), sim.particles().size());
+    // Real time unless stepping outgrew its budget: then say how far behind it fell.
     if (app.droppedSeconds > 0)
-        ImGui::TextDisabled("%.1f s of simulated time dropped (frames slower than %d steps)", app.droppedSeconds,
-                            App::kMaxStepsPerFrame);
+        ImGui::TextColored(ImVec4(1.0f, 0.75f, 0.3f, 1.0f), "behind real time: %.1f s dropped (stepping over %.0f ms a frame)",
+                           app.droppedSeconds, app.stepBudgetMs);
+    else if (!app.paused)
+        ImGui::TextDisabled("real time: stepping %.2f ms this frame", app.lastStepMs);
     ImGui::Separator();
     ImGui::Text("%.1f ms per frame (%.1f fps), rendering %dx%d", state.frameMs, state.frameMs > 0 ? 1000.0 / state.frameMs : 0.0,
                 int(state.image.z * state.renderScale), int(state.image.w * state.renderScale));

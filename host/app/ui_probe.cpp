@@ -30,6 +30,8 @@ nlohmann::json probeState(const WindowState& state, uint64_t frame) {
     j["viewed"] = app.viewed;
     j["image"] = {state.image.x, state.image.y, state.image.z, state.image.w};
     j["frame_ms"] = state.frameMs;
+    j["sim_time"] = app.scene().time();           // seconds simulated
+    j["sim_dropped_s"] = app.droppedSeconds;      // simulated seconds given up to the step budget
     j["render_scale"] = state.renderScale;
     j["errors"] = app.runtime().activeErrors();
     j["editor_error"] = state.editor.error;

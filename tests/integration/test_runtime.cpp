@@ -2,6 +2,7 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -248,4 +249,31 @@ TEST_CASE("setParam changes the running pass without a recompile, refuses bad va
     const TextureRef* depth = rt.findTexture("shadow", "depth");
     REQUIRE(depth);
     CHECK(depth->width == 512);
+}
+
+TEST_CASE("the window's clock keeps real time while stepping fits its budget, and drops only what it cannot step",
+          "[runtime][gl]") {
+    Fixture f(16);
+    app::App& app = f.app;
+    app.paused = false;
+    const double dt = app.scene().dt();
+    // A generous budget: half a second of wall clock is half a second simulated (the old
+    // fixed cap of 4 steps a frame gave 4 dt, 3 % of it, and dropped the rest).
+    app.stepBudgetMs = 1e9;
+    double before = app.scene().time();
+    app.frame(0.5);
+    CHECK(app.lastSteps == int(std::floor(0.5 / dt + 1e-9)));
+    CHECK(app.scene().time() - before == Approx(0.5).margin(dt));  // the remainder waits in the accumulator
+    CHECK(app.droppedSeconds == 0.0);
+    // No budget: one step, and the rest of the half second is counted as dropped.
+    app.stepBudgetMs = 0.0;
+    before = app.scene().time();
+    app.frame(0.5);
+    CHECK(app.lastSteps == 1);
+    CHECK(app.scene().time() - before == Approx(dt));
+    CHECK(app.droppedSeconds == Approx(0.5 - dt).margin(dt));
+    // A reset (R) starts the count over.
+    app.scene().reset();
+    app.frame(0.0);
+    CHECK(app.droppedSeconds == 0.0);
 }
