@@ -147,7 +147,9 @@ void pipelineSwitcher(WindowState& state) {
                 std::string errors;
                 if (app.runtime().loadPipeline(p, errors)) {
                     state.editor.error.clear();  // live reload follows runtime().pipelineFile()
-                    if (name == "compare.json") state.compare.on = true;
+                    // The compare view follows the pipeline: on for compare.json, off when
+                    // leaving it (it would compare textures the new graph does not have).
+                    state.compare.on = name == "compare.json";
                 } else {
                     state.editor.error = errors;  // the running pipeline stays
                 }

@@ -269,6 +269,17 @@ try:
           "dragging the compare line to a quarter leaves it there after the button is up: %.3f" % p["compare"]["split"])
     screenshot("compare.png")
 
+    # 10. Back to default.json: the compare view follows the pipeline and goes off (it
+    #     stayed on, comparing textures the default graph does not have).
+    click("pipeline-switcher")
+    wait_for(lambda p: "pipeline:default.json" in p["widgets"], "the pipeline list")
+    click("pipeline:default.json")
+    wait_for(lambda p: p["pipeline"].endswith("default.json"), "default.json loaded")
+    frames_later()
+    p = probe()
+    check(not p["compare"]["on"], "leaving compare.json turns the compare view off")
+    check(not any("reference" in e for e in p["errors"]), "no error about the reference's textures: %s" % p["errors"])
+
 finally:
     kiln.terminate()
     try:
