@@ -281,7 +281,9 @@ void TextureViewer::readoutAndHistogram(const run::NamedTexture& nt, const std::
         ImGui::Text("texel %d, %d%s  mip %d", r.texel.x, r.texel.y, is3D ? (", " + std::to_string(r.texel.z)).c_str() : "", r.mip);
         if (r.isInteger) ImGui::Text("value %u", unsigned(r.value.r));
         else if (r.isDepth && nt.depthNear > 0.0f)
-            ImGui::Text("depth %.7g  (%.5g m from the camera)", r.value.r, linearDepth(r.value.r, nt.depthNear, nt.depthFar));
+            // The pass that wrote it rendered from its own eye (shadow: the lamp's).
+            ImGui::Text("depth %.7g  (%.5g m from %s's eye)", r.value.r, linearDepth(r.value.r, nt.depthNear, nt.depthFar),
+                        nt.pass.c_str());
         else if (r.isDepth) ImGui::Text("depth %.7g", r.value.r);
         else ImGui::Text("%.6g  %.6g  %.6g  %.6g", r.value.r, r.value.g, r.value.b, r.value.a);
     } else {

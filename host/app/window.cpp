@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <filesystem>
 
@@ -50,6 +51,17 @@ void followBudget(WindowState& state, double now) {
         state.renderScale = std::min(1.0f, state.renderScale * 1.25f);
         state.lastScaleChange = now;
     }
+}
+
+// $XDG_CONFIG_HOME/kiln/imgui.ini (else ~/.config/kiln/imgui.ini); "" when there is
+// no such directory and it cannot be made (then nothing persists).
+std::string imguiIniPath() {
+    const char* xdg = std::getenv("XDG_CONFIG_HOME");
+    const char* home = std::getenv("HOME");
+    const fs::path dir = xdg && *xdg ? fs::path(xdg) / "kiln" : home && *home ? fs::path(home) / ".config/kiln" : fs::path();
+    std::error_code ec;
+    if (dir.empty() || (fs::create_directories(dir, ec), ec)) return "";
+    return (dir / "imgui.ini").string();
 }
 
 // What the command line asks of the window at start.
@@ -102,7 +114,9 @@ int runWindow(const Options& o) {
     // Ours first: ImGui's GLFW backend chains to the callbacks it finds installed.
     IMGUI_CHECKVERSION();
     ImGui::CreateContext();
-    ImGui::GetIO().IniFilename = nullptr;
+    // Panel positions and sizes persist between runs, in the user's config directory.
+    const std::string ini = imguiIniPath();
+    ImGui::GetIO().IniFilename = ini.empty() ? nullptr : ini.c_str();
     ImGui_ImplGlfw_InitForOpenGL(window, true);
     ImGui_ImplOpenGL3_Init("#version 450 core");
 

@@ -122,6 +122,11 @@ os.makedirs(modules)
 shutil.copy(BUGGY_MODULE, os.path.join(modules, "libpass_test_faulty.so"))
 build_modules = os.path.join(os.path.dirname(os.path.dirname(KILN)), "modules")
 
+# Panel positions persist in $XDG_CONFIG_HOME/kiln/imgui.ini: a fresh one, so the layout
+# is the first-run layout whatever an earlier run left.
+config = os.path.join(OUT, "config")
+shutil.rmtree(config, ignore_errors=True)
+
 # What a headless run reads back for the same paused frame at the same size.
 dump = os.path.join(OUT, "dump")
 shutil.rmtree(dump, ignore_errors=True)
@@ -130,7 +135,7 @@ sh(KILN, "--headless", "--paused", "--size", "%dx%d" % (W, H), "--pipeline", def
 
 kiln = subprocess.Popen([KILN, "--paused", "--size", "%dx%d" % (W, H), "--pipeline", default, "--budget", "0",
                          "--ui-probe", PROBE, "--modules", modules + ":" + build_modules],
-                        env=dict(os.environ, KILN_TEST_FAULT="segv@execute"),
+                        env=dict(os.environ, KILN_TEST_FAULT="segv@execute", XDG_CONFIG_HOME=config),
                         stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
 try:
     wait_for(lambda p: p["frame"] >= 3, "the first frames")
