@@ -413,6 +413,8 @@ void drawSidebar(WindowState& state) {
             state.viewer.window(*t, &state.showTexture);
             const glm::vec4 c = state.viewer.canvasRect();
             if (state.probe.on()) state.probe.widgets["texture-canvas"] = {c.x, c.y, c.z, c.w};
+            if (const glm::vec4 h = state.viewer.histogramRect(); state.probe.on() && h.z > h.x)
+                state.probe.widgets["texture-histogram"] = {h.x, h.y, h.z, h.w};
         }
 }
 

@@ -161,7 +161,7 @@ void TextureViewer::window(const run::NamedTexture& nt, bool* open) {
     ViewSettings& s = settings_[name];
     ImGuiIO& io = ImGui::GetIO();
     ImGui::SetNextWindowPos(ImVec2(io.DisplaySize.x - 8, 8), ImGuiCond_FirstUseEver, ImVec2(1, 0));
-    ImGui::SetNextWindowSize(ImVec2(440, 560), ImGuiCond_FirstUseEver);
+    ImGui::SetNextWindowSize(ImVec2(440, std::min(560.0f, io.DisplaySize.y - 16)), ImGuiCond_FirstUseEver);
     if (!ImGui::Begin("Texture", open)) {
         ImGui::End();
         return;
@@ -292,9 +292,19 @@ void TextureViewer::readoutAndHistogram(const run::NamedTexture& nt, const std::
     }
     if (fit_ && fitFor_ == name) {
         char overlay[96];
-        std::snprintf(overlay, sizeof overlay, "%.4g .. %.4g  (%zu texels%s)", fit_->min, fit_->max, fit_->texels,
-                      fit_->nonFinite ? ", some NaN/Inf" : "");
-        ImGui::PlotHistogram("##histogram", fit_->histogram.data(), 64, 0, overlay, 0.0f, FLT_MAX, ImVec2(-1, 48));
+        std::snprintf(overlay, sizeof overlay, "%.4g .. %.4g  (%zu texels%s; log counts)", fit_->min, fit_->max,
+                      fit_->texels, fit_->nonFinite ? ", some NaN/Inf" : "");
+        // Log heights: one bin (empty voxels, the background) often holds most texels.
+        std::array<float, 64> heights;
+        for (size_t i = 0; i < heights.size(); ++i) heights[i] = std::log1p(fit_->histogram[i]);
+        // The width in pixels: ImGui 1.86's plots take a negative size literally (a
+        // 1-pixel histogram), unlike its other widgets.
+        ImGui::PlotHistogram("##histogram", heights.data(), 64, 0, overlay, 0.0f, FLT_MAX,
+                             ImVec2(ImGui::GetContentRegionAvail().x, 48));
+        const ImVec2 lo = ImGui::GetItemRectMin(), hi = ImGui::GetItemRectMax();
+        histogramRect_ = {lo.x, lo.y, hi.x, hi.y};
+    } else {
+        histogramRect_ = glm::vec4(0.0f);
     }
 }
 

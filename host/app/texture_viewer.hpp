@@ -69,6 +69,7 @@ public:
     void window(const run::NamedTexture& t, bool* open);
     // Screen rectangle of the canvas in the last window() (x0, y0, x1, y1), for --ui-probe.
     glm::vec4 canvasRect() const { return canvasRect_; }
+    glm::vec4 histogramRect() const { return histogramRect_; }  // zero when none is drawn
 
     ViewSettings& settingsFor(const std::string& name) { return settings_[name]; }
     const std::optional<TexelReadout>& lastReadout() const { return readout_; }
@@ -98,7 +99,7 @@ private:
     std::optional<RangeFit> fit_;
     std::string fitFor_;           // which texture fit_ describes
     bool autoFit_ = false;
-    glm::vec4 canvasRect_{0.0f};
+    glm::vec4 canvasRect_{0.0f}, histogramRect_{0.0f};
 };
 
 }  // namespace kiln::app

@@ -176,6 +176,18 @@ try:
     click("texture:voxelize.count")
     p = wait_for(lambda p: p["viewed"] == "voxelize.count" and "fit" in p, "a fit of voxelize.count")
     check(p["fit"][1] >= 1, "voxelize.count (R32UI) fits to a range with counts: %s" % p["fit"])
+    # ... and its 64-bin histogram is drawn under the image: as wide as the window, with
+    # bars (ImGui's plot colour, orange) in it. It was 1 px wide and empty.
+    p = wait_for(lambda p: "texture-histogram" in p["widgets"], "the histogram")
+    hx0, hy0, hx1, hy1 = [int(v) for v in p["widgets"]["texture-histogram"]]
+    check(hx1 - hx0 > 100, "the histogram is %d px wide" % (hx1 - hx0))
+    text = sh("convert", screenshot("histogram.png"), "-crop", "%dx%d+%d+%d" % (hx1 - hx0, hy1 - hy0, hx0, hy0),
+              "-depth", "8", "txt:-")
+    bars = 0
+    for line in text.splitlines()[1:]:
+        r, g, b = [float(c) for c in line.split("(")[1].split(")")[0].split(",")[:3]]
+        bars += r > 150 and g > 90 and b < 80
+    check(bars > 20, "the histogram shows bars: %d orange pixels" % bars)
 
     # 3. A parameter: ctrl+click composite.exposure, type 0.25; the image darkens.
     before = image_mean(screenshot("before.png"), probe())
