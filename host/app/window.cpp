@@ -64,6 +64,15 @@ std::string imguiIniPath() {
     return (dir / "imgui.ini").string();
 }
 
+// Panel positions and sizes persist between runs in `ini` ("" : nowhere).
+void startImGui(GLFWwindow* window, const std::string& ini) {
+    IMGUI_CHECKVERSION();
+    ImGui::CreateContext();
+    ImGui::GetIO().IniFilename = ini.empty() ? nullptr : ini.c_str();
+    ImGui_ImplGlfw_InitForOpenGL(window, true);
+    ImGui_ImplOpenGL3_Init("#version 450 core");
+}
+
 // What the command line asks of the window at start.
 void startState(WindowState& state, const Options& o, App& app) {
     state.app = &app;
@@ -110,15 +119,9 @@ int runWindow(const Options& o) {
     startState(state, o, app);
     GLFWwindow* window = context->window();
     glfwSetWindowUserPointer(window, &state);
-    installCallbacks(window);
-    // Ours first: ImGui's GLFW backend chains to the callbacks it finds installed.
-    IMGUI_CHECKVERSION();
-    ImGui::CreateContext();
-    // Panel positions and sizes persist between runs, in the user's config directory.
-    const std::string ini = imguiIniPath();
-    ImGui::GetIO().IniFilename = ini.empty() ? nullptr : ini.c_str();
-    ImGui_ImplGlfw_InitForOpenGL(window, true);
-    ImGui_ImplOpenGL3_Init("#version 450 core");
+    installCallbacks(window);  // ours first: ImGui's GLFW backend chains to the callbacks it finds
+    const std::string ini = imguiIniPath();  // outlives ImGui, which keeps a pointer to it
+    startImGui(window, ini);
 
     using Clock = std::chrono::steady_clock;
     const Clock::time_point start = Clock::now();
