@@ -27,6 +27,18 @@ void keepFreedHeap() {
     (void)done;
 }
 
+// "a:b::c" → a, b, c.
+std::vector<std::string> pathList(const std::string& list) {
+    std::vector<std::string> out;
+    for (size_t start = 0; start <= list.size();) {
+        size_t end = list.find(':', start);
+        if (end == std::string::npos) end = list.size();
+        if (end > start) out.push_back(list.substr(start, end - start));
+        start = end + 1;
+    }
+    return out;
+}
+
 }  // namespace
 
 bool App::init(const Options& o, std::string& error) {
@@ -35,14 +47,10 @@ bool App::init(const Options& o, std::string& error) {
     paused = o.paused;
     viewed = o.view;
     run::RuntimeOptions ro;
-    ro.shaderRoots = {o.shaderRoot};
-    // --modules may list several directories, separated by ':'.
-    for (size_t start = 0; start <= o.moduleDir.size();) {
-        size_t end = o.moduleDir.find(':', start);
-        if (end == std::string::npos) end = o.moduleDir.size();
-        if (end > start) ro.moduleDirs.emplace_back(o.moduleDir.substr(start, end - start));
-        start = end + 1;
-    }
+    // --shaders and --modules may list several directories, separated by ':'; the first
+    // that has a file wins.
+    for (const std::string& dir : pathList(o.shaderRoot)) ro.shaderRoots.emplace_back(dir);
+    for (const std::string& dir : pathList(o.moduleDir)) ro.moduleDirs.emplace_back(dir);
     ro.width = o.width;
     ro.height = o.height;
     if (!runtime_.init(ro, error)) return false;

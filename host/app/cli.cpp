@@ -36,7 +36,8 @@ usage: kiln [options]
                     S seconds is interrupted and named (default 10; 0: never)
   --seed N          simulation seed (same seed, same frames)
   --paused          do not advance the simulation
-  --shaders DIR     shader root (default shaders/, see below)
+  --shaders DIRS    shader roots, ':'-separated, the first that has a file wins
+                    (default shaders/, see below); all are watched
   --modules DIRS    pass module directories, ':'-separated (default: the build's modules/)
   --help            this text
 

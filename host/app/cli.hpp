@@ -13,7 +13,7 @@ inline constexpr uint64_t kSceneSeed = ~0ull;
 struct Options {
     std::string pipeline;     // default: <source>/pipelines/default.json
     std::string scene;        // default: <source>/scenes/cornell.json
-    std::string shaderRoot;   // default: <source>/shaders
+    std::string shaderRoot;   // ':'-separated roots; default: <source>/shaders
     std::string moduleDir;    // default: the build's modules directory
     bool headless = false;
     int width = 720, height = 720;

@@ -3,6 +3,7 @@
 // are checked to be the same, and the built module is run and its pixels checked.
 #include <catch2/catch.hpp>
 
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -94,4 +95,45 @@ TEST_CASE("the manual's tint pass multiplies what it reads by its tint, its para
                 lit += expected > 0.01f;
             }
     CHECK(lit > after.width * after.height);  // the box is lit: the check compared real values
+}
+
+TEST_CASE("several shader roots (--shaders A:B): the first that has a file wins, the others fill in", "[integration][gl]") {
+    REQUIRE(test::ensureHeadlessContext());
+    // A root of one's own with only tint/tint.frag (a constant green), ahead of Kiln's.
+    const fs::path mine = fs::path(TEST_OUTPUT_DIR) / "shader-roots" / "mine";
+    fs::remove_all(mine.parent_path());
+    fs::create_directories(mine / "tint");
+    std::ofstream(mine / "tint/tint.frag") << "#version 450 core\nlayout(location = 0) out vec4 o_color;\n"
+                                              "void main() { o_color = vec4(0.0, 1.0, 0.0, 1.0); }\n";
+    const std::string pipeline = R"({"output": "tint.color", "passes": [
+          {"id": "gbuffer", "module": "gbuffer"},
+          {"id": "composite", "module": "composite",
+           "inputs": {"albedo": "gbuffer.albedo", "normal": "gbuffer.normal", "depth": "gbuffer.depth"}},
+          {"id": "tint", "module": "tint", "inputs": {"color": "composite.hdr"}}]})";
+    auto centre = [&](const std::string& roots) {
+        app::Options o = test::pausedHeadlessOptions(16);
+        o.shaderRoot = roots;
+        app::App app;
+        std::string error;
+        INFO(error);
+        REQUIRE(app.init(o, error));
+        REQUIRE(app.runtime().loadPipelineText(pipeline, "roots.json", error));
+        app.frame();
+        for (auto& e : app.runtime().activeErrors()) FAIL(e);
+        const TextureRef* t = app.runtime().findTexture("tint", "color");
+        REQUIRE(t);
+        const FloatImage img = readTexture(t->id, t->target, t->format, t->width, t->height);
+        const float* p = img.at(8, 8);
+        return std::array<float, 3>{p[0], p[1], p[2]};
+    };
+    const std::string kilns = std::string(KILN_SOURCE_DIR) + "/shaders";
+    // Kiln's root alone: the manual's tint of the lit box (red kept, green and blue halved).
+    const auto tinted = centre(kilns);
+    CHECK_FALSE((tinted[0] == 0.0f && tinted[1] == 1.0f && tinted[2] == 0.0f));
+    // Mine first: its tint.frag wins; gbuffer's and composite's shaders (and
+    // common/fullscreen.vert, which mine lacks) come from Kiln's root.
+    const auto green = centre(mine.string() + ":" + kilns);
+    CHECK(green[0] == 0.0f);
+    CHECK(green[1] == 1.0f);
+    CHECK(green[2] == 0.0f);
 }
