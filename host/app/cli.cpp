@@ -18,7 +18,9 @@ usage: kiln [options]
   --size WxH        output size (default 720x720)
   --frames N        frames to render in headless mode (default 1)
   --out FILE.png    write the final image (headless)
-  --dump DIR        write every texture of the last frame (PNG, and OpenEXR for float/depth)
+  --dump DIR        headless: write every texture of the last frame (PNG, and OpenEXR for
+                    float/depth); window: where the texture window's "save" writes
+                    (default ./kiln-saves)
   --stats           print the per-pass time table (GPU timer queries + CPU clock)
   --no-live         do not watch files for live reloading
   --no-skip         run every pass every frame, even when nothing it reads changed

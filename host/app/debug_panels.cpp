@@ -415,6 +415,8 @@ void drawSidebar(WindowState& state) {
             if (state.probe.on()) state.probe.widgets["texture-canvas"] = {c.x, c.y, c.z, c.w};
             if (const glm::vec4 h = state.viewer.histogramRect(); state.probe.on() && h.z > h.x)
                 state.probe.widgets["texture-histogram"] = {h.x, h.y, h.z, h.w};
+            if (const glm::vec4 b = state.viewer.saveButtonRect(); state.probe.on() && b.z > b.x)
+                state.probe.widgets["texture-save"] = {b.x, b.y, b.z, b.w};
         }
 }
 

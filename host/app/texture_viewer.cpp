@@ -11,6 +11,8 @@
 
 namespace kiln::app {
 
+namespace fs = std::filesystem;
+
 namespace {
 
 using gl::isDepthFormat;
@@ -213,6 +215,11 @@ bool TextureViewer::controls(const run::NamedTexture& nt, ViewSettings& s) {
     if (ImGui::Button("1:1")) s.zoom = 1.0f;
     ImGui::SameLine();
     if (ImGui::Button("fit")) s.zoom = 0.0f, s.center = glm::vec2(-1.0f);
+    ImGui::SameLine();
+    if (ImGui::Button("save")) save(nt, s);
+    const ImVec2 lo = ImGui::GetItemRectMin(), hi = ImGui::GetItemRectMax();
+    saveButtonRect_ = {lo.x, lo.y, hi.x, hi.y};
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("write it as PNG (and EXR for float data) into %s", saveDir_.c_str());
     ImGui::DragFloatRange2("range", &s.rangeMin, &s.rangeMax, std::max(1e-4f, (s.rangeMax - s.rangeMin) * 0.005f), 0, 0, "%.5g", "%.5g");
     if (s.channel != 0) ImGui::Checkbox("false colour", &s.falseColor), ImGui::SameLine();
     ImGui::Checkbox("alpha checkerboard", &s.checker);
@@ -222,6 +229,7 @@ bool TextureViewer::controls(const run::NamedTexture& nt, ViewSettings& s) {
         ImGui::Checkbox("depth in metres", &s.linearizeDepth);
         if (ImGui::IsItemHovered()) ImGui::SetTooltip("linearised with the producing camera's planes %.3g .. %.3g", nt.depthNear, nt.depthFar);
     }
+    if (!lastSaved_.empty()) ImGui::TextDisabled("saved: %s", lastSaved_.c_str());
     if (t.levels > 1) ImGui::SliderInt("mip", &s.mip, 0, t.levels - 1);
     if (is3D) {
         const char* axes[] = {"x", "y", "z"};
@@ -233,6 +241,28 @@ bool TextureViewer::controls(const run::NamedTexture& nt, ViewSettings& s) {
         if (ImGui::SliderInt("slice", &slice, 0, levelSize(t, mip)[s.axis] - 1)) s.slice = slice;
     }
     return fitNow;
+}
+
+void TextureViewer::save(const run::NamedTexture& nt, const ViewSettings& s) {
+    const TextureRef& t = nt.ref;
+    const int mip = clampedMip(t, s);
+    const bool is3D = t.target == GL_TEXTURE_3D;
+    const int slice = is3D ? (s.axis == 2 ? clampedSlice(t, s, mip) : levelSize(t, mip).z / 2) : -1;
+    const FloatImage img = readTexture(t.id, t.target, t.format, std::max(1, t.width >> mip),
+                                       std::max(1, t.height >> mip), mip, slice);
+    std::string name = nt.pass + "." + nt.name;
+    if (mip > 0) name += ".mip" + std::to_string(mip);
+    if (is3D) name += ".z" + std::to_string(slice);
+    std::error_code ec;
+    fs::create_directories(saveDir_, ec);
+    const fs::path base = saveDir_ / name;
+    std::string error;
+    if (ec) lastSaved_ = saveDir_.string() + ": cannot create: " + ec.message();
+    else if (!writePng(base.string() + ".png", img, 4, error) ||
+             (run::isFloatFormat(t.format) && !writeExr(base.string() + ".exr", img, error)))
+        lastSaved_ = error;
+    else lastSaved_ = base.string() + (run::isFloatFormat(t.format) ? ".png and .exr" : ".png");
+    log::info("texture window: ", lastSaved_);
 }
 
 void TextureViewer::ensureCanvas(glm::ivec2 size) {

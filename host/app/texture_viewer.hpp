@@ -8,6 +8,7 @@
 #include <glm/glm.hpp>
 
 #include <array>
+#include <filesystem>
 #include <map>
 #include <optional>
 #include <string>
@@ -70,6 +71,11 @@ public:
     // Screen rectangle of the canvas in the last window() (x0, y0, x1, y1), for --ui-probe.
     glm::vec4 canvasRect() const { return canvasRect_; }
     glm::vec4 histogramRect() const { return histogramRect_; }  // zero when none is drawn
+    glm::vec4 saveButtonRect() const { return saveButtonRect_; }
+    // Where "save" writes the texture shown (PNG, and OpenEXR with the raw values for
+    // float and depth formats): --dump's directory, else ./kiln-saves.
+    void setSaveDirectory(std::filesystem::path dir) { saveDir_ = std::move(dir); }
+    const std::string& lastSaved() const { return lastSaved_; }  // the file written, or why not
 
     ViewSettings& settingsFor(const std::string& name) { return settings_[name]; }
     const std::optional<TexelReadout>& lastReadout() const { return readout_; }
@@ -85,6 +91,8 @@ private:
     // the canvas texture at `size`, the mouse over it (pan, zoom, the texel under the
     // cursor), the readout and histogram below it.
     bool controls(const run::NamedTexture& nt, ViewSettings& s);
+    // Writes the level (and, for 3D seen along z, the slice) on view; says so in lastSaved_.
+    void save(const run::NamedTexture& nt, const ViewSettings& s);
     void ensureCanvas(glm::ivec2 size);
     void canvasInput(const TextureRef& t, ViewSettings& s, glm::vec2 canvasTopLeft, glm::ivec2 size, bool hovered,
                      bool active);
@@ -99,7 +107,9 @@ private:
     std::optional<RangeFit> fit_;
     std::string fitFor_;           // which texture fit_ describes
     bool autoFit_ = false;
-    glm::vec4 canvasRect_{0.0f}, histogramRect_{0.0f};
+    glm::vec4 canvasRect_{0.0f}, histogramRect_{0.0f}, saveButtonRect_{0.0f};
+    std::filesystem::path saveDir_ = "kiln-saves";
+    std::string lastSaved_;
 };
 
 }  // namespace kiln::app

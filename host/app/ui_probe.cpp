@@ -41,6 +41,7 @@ nlohmann::json probeState(const WindowState& state, uint64_t frame) {
                         {"value", {r->value.r, r->value.g, r->value.b, r->value.a}}};
     }
     if (const auto& f = state.viewer.lastFit()) j["fit"] = {f->min, f->max};
+    if (!state.viewer.lastSaved().empty()) j["saved"] = state.viewer.lastSaved();
     j["compare"] = {{"on", state.compare.on}, {"split", state.compare.split}};
     if (const auto& e = state.compare.errors())
         j["compare"]["errors"] = {{"rmse", e->rmse}, {"rel_mse", e->relMse}, {"psnr", e->psnr}, {"ssim", e->ssim},

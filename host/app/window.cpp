@@ -84,6 +84,7 @@ void startState(WindowState& state, const Options& o, App& app) {
     state.budgetMs = o.budgetMs > 0 ? float(o.budgetMs) : state.budgetMs;
     std::string error;
     if (!state.viewer.init(app.runtime().shaders(), error)) log::error(error);
+    if (!o.dump.empty()) state.viewer.setSaveDirectory(o.dump);
 }
 
 // The debug view over the image: the sidebar's panels and the error overlay.

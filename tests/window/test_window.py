@@ -133,7 +133,10 @@ shutil.rmtree(dump, ignore_errors=True)
 sh(KILN, "--headless", "--paused", "--size", "%dx%d" % (W, H), "--pipeline", default, "--dump", dump,
    "--view", "gbuffer.albedo", "--no-live")
 
+saves = os.path.join(OUT, "saves")
+shutil.rmtree(saves, ignore_errors=True)
 kiln = subprocess.Popen([KILN, "--paused", "--size", "%dx%d" % (W, H), "--pipeline", default, "--budget", "0",
+                         "--dump", saves,
                          "--ui-probe", PROBE, "--modules", modules + ":" + build_modules],
                         env=dict(os.environ, KILN_TEST_FAULT="segv@execute", XDG_CONFIG_HOME=config),
                         stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
@@ -168,6 +171,14 @@ try:
               "readout at texel (%d, %d) %s equals the headless read-back %s (within half a step of 8 bits)"
               % (tx, ty, [round(v, 4) for v in value[:3]], [round(v, 4) for v in expected]))
     check(len(seen) == 3, "three places, three different albedos: %s" % seen)
+    #    "save" writes what the window shows: the same pixels as the headless dump.
+    click("texture-save")
+    p = wait_for(lambda p: "saved" in p, "the texture saved")
+    saved = os.path.join(saves, "gbuffer.albedo.png")
+    check(p["saved"] == saved[:-len(".png")] + ".png", "saved to %s: %s" % (saved, p["saved"]))
+    differing = subprocess.run(["compare", "-metric", "AE", saved, os.path.join(dump, "gbuffer.albedo.png"), "null:"],
+                               capture_output=True, text=True).stderr.strip()
+    check(differing == "0", "the saved gbuffer.albedo equals the headless dump's, pixel for pixel (%s differ)" % differing)
 
     # 2. An integer texture (R32UI voxel counts) is not black: the fitted range is > 0.
     click("texture-filter")
