@@ -15,6 +15,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
+constexpr int kLegendPx = 10;  // the colour map's strip under a one-channel texture
 using gl::isDepthFormat;
 bool isSingleChannel(GLenum f) { return isDepthFormat(f) || gl::isIntegerFormat(f) || f == GL_R16F || f == GL_R32F || f == GL_R8; }
 
@@ -83,7 +84,8 @@ bool TextureViewer::init(const ShaderLibrary& shaders, std::string& error) {
     return reload(shaders, error);
 }
 
-void TextureViewer::draw(const TextureRef& t, float depthNear, float depthFar, const ViewSettings& s, glm::ivec4 rect) const {
+void TextureViewer::draw(const TextureRef& t, float depthNear, float depthFar, const ViewSettings& s, glm::ivec4 rect,
+                         int legendPx) const {
     if (!program_ || !t.id) return;
     const bool is3D = t.target == GL_TEXTURE_3D, isUint = gl::isIntegerFormat(t.format);
     const int mip = clampedMip(t, s);
@@ -105,6 +107,7 @@ void TextureViewer::draw(const TextureRef& t, float depthNear, float depthFar, c
     glUniform1i(loc("u_axis"), std::clamp(s.axis, 0, 2));
     glUniform1i(loc("u_checker"), s.checker);
     glUniform1i(loc("u_tonemap"), s.tonemap);
+    glUniform1f(loc("u_legend"), float(legendPx));
     glUniform2f(loc("u_canvasOrigin"), float(rect.x), float(rect.y));
     glUniform2f(loc("u_canvasSize"), canvas.x, canvas.y);
     const glm::vec2 center = effectiveCenter(s, plane);
@@ -182,8 +185,10 @@ void TextureViewer::window(const run::NamedTexture& nt, bool* open) {
     if (!s.fitted && !isSingleChannel(t.format)) s.fitted = true;
     if (!s.fitted) s.channel = 1;  // one channel: shown in false colour
     if (fitNow || autoFit_ || !s.fitted) fit_ = fitRange(t, nt.depthNear, nt.depthFar, s, glm::vec2(size)), s.fitted = true;
+    // One channel (grey or false colour): a legend of the map along the canvas's bottom.
+    const int legend = s.channel != 0 ? kLegendPx : 0;
     glBindFramebuffer(GL_FRAMEBUFFER, canvasFbo_.id());
-    draw(t, nt.depthNear, nt.depthFar, s, {0, 0, size.x, size.y});
+    draw(t, nt.depthNear, nt.depthFar, s, {0, 0, size.x, size.y}, legend);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
 
     const ImVec2 p0 = ImGui::GetCursorScreenPos();
@@ -192,6 +197,15 @@ void TextureViewer::window(const run::NamedTexture& nt, bool* open) {
     canvasRect_ = {p0.x, p0.y, p0.x + size.x, p0.y + size.y};
     ImGui::GetWindowDrawList()->AddImage(ImTextureID(intptr_t(canvas_.id())), p0, ImVec2(p0.x + size.x, p0.y + size.y),
                                          ImVec2(0, 1), ImVec2(1, 0));
+    if (legend) {  // the range's ends, on the legend's ends
+        char lo[32], hi[32];
+        std::snprintf(lo, sizeof lo, "%.4g", s.rangeMin);
+        std::snprintf(hi, sizeof hi, "%.4g", s.rangeMax);
+        ImDrawList* list = ImGui::GetWindowDrawList();
+        const float y = p0.y + size.y - kLegendPx - ImGui::GetTextLineHeight();
+        list->AddText(ImVec2(p0.x + 2, y), IM_COL32_WHITE, lo);
+        list->AddText(ImVec2(p0.x + size.x - ImGui::CalcTextSize(hi).x - 2, y), IM_COL32_WHITE, hi);
+    }
     canvasInput(t, s, glm::vec2(p0.x, p0.y), size, hovered, active);
     readoutAndHistogram(nt, name);
     ImGui::PopID();

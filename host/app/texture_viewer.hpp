@@ -65,7 +65,9 @@ public:
 
     // Draws `t` into the current framebuffer's rectangle (x, y, w, h in GL pixels,
     // origin bottom-left) with `s`.
-    void draw(const TextureRef& t, float depthNear, float depthFar, const ViewSettings& s, glm::ivec4 rect) const;
+    // `legendPx` > 0: a strip that tall along the bottom shows the colour map over the range.
+    void draw(const TextureRef& t, float depthNear, float depthFar, const ViewSettings& s, glm::ivec4 rect,
+              int legendPx = 0) const;
     // The "Texture" ImGui window for `t`: toolbar, canvas, readout, histogram.
     void window(const run::NamedTexture& t, bool* open);
     // Screen rectangle of the canvas in the last window() (x0, y0, x1, y1), for --ui-probe.

@@ -49,7 +49,16 @@ ivec3 levelSize() {
     return textureSize(u_utex3d, u_mip);
 }
 
+uniform float u_legend;       // > 0: a strip this many pixels tall along the canvas's bottom
+                              // shows the map from the range's low end (left) to its high end
+
 void main() {
+    // The legend: the same map the texels go through, so it cannot disagree with them.
+    if (gl_FragCoord.y - u_canvasOrigin.y < u_legend) {
+        float x = (gl_FragCoord.x - u_canvasOrigin.x) / max(u_canvasSize.x - 1.0, 1.0);
+        o_color = vec4(u_falseColor ? turbo(x) : vec3(x), 1.0);
+        return;
+    }
     vec2 t = (gl_FragCoord.xy - u_canvasOrigin - u_canvasSize * 0.5) / u_zoom + u_center;
     ivec3 size = levelSize();
     ivec2 planeSize = u_kind == 1 || u_kind == 3 ? (u_axis == 0 ? size.yz : u_axis == 1 ? size.xz : size.xy) : size.xy;

@@ -199,6 +199,14 @@ try:
         r, g, b = [float(c) for c in line.split("(")[1].split(")")[0].split(",")[:3]]
         bars += r > 150 and g > 90 and b < 80
     check(bars > 20, "the histogram shows bars: %d orange pixels" % bars)
+    # ... and a legend of the false-colour map along the canvas's bottom: turbo's green in
+    # the middle, its dark red at the high end. (Its low end sits under the sidebar's
+    # column at this window size.)
+    cx0, cy0, cx1, cy1 = [int(v) for v in p["widgets"]["texture-canvas"]]
+    middle = screen_pixel((cx0 + cx1) // 2, cy1 - 4, os.path.join(OUT, "histogram.png"))
+    high = screen_pixel(cx1 - 4, cy1 - 4, os.path.join(OUT, "histogram.png"))
+    check(middle[1] > 150 and middle[1] > middle[0] and middle[1] > middle[2], "the legend is green midway: %s" % middle)
+    check(high[0] > 100 and high[0] > 3 * high[2], "the legend ends red: %s" % high)
 
     # 3. A parameter: ctrl+click composite.exposure, type 0.25; the image darkens.
     before = image_mean(screenshot("before.png"), probe())
