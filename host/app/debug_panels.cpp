@@ -222,7 +222,7 @@ void panelTextures(WindowState& state) {
     if (ImGui::RadioButton("image: graph output", !state.mainShowsSelection)) state.mainShowsSelection = false;
     ImGui::SameLine();
     if (ImGui::RadioButton("selected texture", state.mainShowsSelection)) state.mainShowsSelection = true;
-    static ImGuiTextFilter filter;
+    ImGuiTextFilter& filter = state.textureFilter;
     filter.Draw("filter", 160);
     state.probe.item("texture-filter");
     for (auto& t : app.runtime().textures()) {

@@ -35,6 +35,7 @@ nlohmann::json probeState(const WindowState& state, uint64_t frame) {
     j["render_scale"] = state.renderScale;
     j["errors"] = app.runtime().activeErrors();
     j["editor_error"] = state.editor.error;
+    j["texture_filter"] = std::string(state.textureFilter.InputBuf);
     if (const auto& r = state.viewer.lastReadout()) {
         j["readout"] = {{"texel", {r->texel.x, r->texel.y, r->texel.z}},
                         {"mip", r->mip},

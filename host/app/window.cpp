@@ -69,7 +69,8 @@ void startImGui(GLFWwindow* window, const std::string& ini) {
     IMGUI_CHECKVERSION();
     ImGui::CreateContext();
     ImGui::GetIO().IniFilename = ini.empty() ? nullptr : ini.c_str();
-    ImGui_ImplGlfw_InitForOpenGL(window, true);
+    // No backend callbacks: ours queue GLFW's events and UiInput feeds them (window_state.hpp).
+    ImGui_ImplGlfw_InitForOpenGL(window, false);
     ImGui_ImplOpenGL3_Init("#version 450 core");
 }
 
@@ -91,6 +92,7 @@ void startState(WindowState& state, const Options& o, App& app) {
 void drawUi(WindowState& state, int fbW, int fbH) {
     ImGui_ImplOpenGL3_NewFrame();
     ImGui_ImplGlfw_NewFrame();
+    state.uiInput.feed(ImGui::GetIO());
     ImGui::NewFrame();
     if (state.showDebug) drawSidebar(state);
     panelErrors(*state.app, state);

@@ -6,29 +6,96 @@
 #include <algorithm>
 #include <cmath>
 
+#include <imgui_internal.h>
+
 #include "app/window_state.hpp"
 
 namespace kiln::app {
 
+namespace {
+// Whether a panel (an ImGui window drawn last frame) covers window pixel (x, y). Asked by
+// position, not through io.WantCaptureMouse: ImGui learns of the cursor through the
+// queue, a frame or more after the press handleMouse is deciding about.
+bool overPanel(double x, double y) {
+    const ImGuiContext& g = *ImGui::GetCurrentContext();
+    const ImVec2 p{float(x), float(y)};
+    for (const ImGuiWindow* w : g.Windows)
+        if (w->Active && !w->Hidden && !(w->Flags & ImGuiWindowFlags_ChildWindow) && w->Rect().Contains(p)) return true;
+    return false;
+}
+
+WindowState& stateOf(GLFWwindow* w) { return *static_cast<WindowState*>(glfwGetWindowUserPointer(w)); }
+bool isModifier(int key) {
+    return key == GLFW_KEY_LEFT_CONTROL || key == GLFW_KEY_RIGHT_CONTROL || key == GLFW_KEY_LEFT_SHIFT ||
+           key == GLFW_KEY_RIGHT_SHIFT || key == GLFW_KEY_LEFT_ALT || key == GLFW_KEY_RIGHT_ALT ||
+           key == GLFW_KEY_LEFT_SUPER || key == GLFW_KEY_RIGHT_SUPER;
+}
+}  // namespace
+
+void UiInput::feed(ImGuiIO& io) {
+    std::map<int, bool> changedKeys;
+    bool keyChanged = false;  // a key other than a modifier went down or up this frame
+    bool changedButtons[ImGuiMouseButton_COUNT] = {};
+    while (!events.empty()) {
+        const Event& e = events.front();
+        if (e.kind == Kind::Move) {
+            // After a press or release this frame, the cursor stays where it happened.
+            if (std::any_of(std::begin(changedButtons), std::end(changedButtons), [](bool b) { return b; })) break;
+            x = e.x, y = e.y;
+        } else if (e.kind == Kind::Button) {
+            if (e.code < 0 || e.code >= ImGuiMouseButton_COUNT) { events.pop_front(); continue; }
+            if (changedButtons[e.code]) break;  // its second transition: next frame
+            buttons[e.code] = e.down, changedButtons[e.code] = true;
+        } else if (e.kind == Kind::Key) {
+            // A key's second transition waits; so does a modifier changing after a key
+            // went down or up this frame (Ctrl released right after A would hide the Ctrl).
+            if (changedKeys[e.code] || (isModifier(e.code) && keyChanged)) break;
+            keys[e.code] = e.down, changedKeys[e.code] = true;
+            keyChanged |= !isModifier(e.code);
+        } else if (e.kind == Kind::Char) {
+            io.AddInputCharacter(e.ch);
+        } else {
+            io.MouseWheelH += float(e.x), io.MouseWheel += float(e.y);
+        }
+        events.pop_front();
+    }
+    io.MousePos = ImVec2(float(x), float(y));
+    for (int b = 0; b < ImGuiMouseButton_COUNT; ++b) io.MouseDown[b] = buttons[b];
+    for (auto& [key, down] : keys)
+        if (key >= 0 && key < int(IM_ARRAYSIZE(io.KeysDown))) io.KeysDown[key] = down;
+    auto held = [&](int a, int b) { return keys[a] || keys[b]; };
+    io.KeyCtrl = held(GLFW_KEY_LEFT_CONTROL, GLFW_KEY_RIGHT_CONTROL);
+    io.KeyShift = held(GLFW_KEY_LEFT_SHIFT, GLFW_KEY_RIGHT_SHIFT);
+    io.KeyAlt = held(GLFW_KEY_LEFT_ALT, GLFW_KEY_RIGHT_ALT);
+    io.KeySuper = held(GLFW_KEY_LEFT_SUPER, GLFW_KEY_RIGHT_SUPER);
+}
+
 void installCallbacks(GLFWwindow* window) {
-    glfwSetScrollCallback(window, [](GLFWwindow* w, double, double dy) {
+    glfwSetScrollCallback(window, [](GLFWwindow* w, double dx, double dy) {
+        WindowState& s = stateOf(w);
+        s.uiInput.events.push_back({UiInput::Kind::Scroll, dx, dy});
         if (ImGui::GetIO().WantCaptureMouse) return;
-        auto* s = static_cast<WindowState*>(glfwGetWindowUserPointer(w));
-        s->app->camera().distance = std::clamp(s->app->camera().distance * float(std::pow(0.9, dy)), 1.5f, 10.0f);
+        s.app->camera().distance = std::clamp(s.app->camera().distance * float(std::pow(0.9, dy)), 1.5f, 10.0f);
     });
     glfwSetCursorPosCallback(window, [](GLFWwindow* w, double x, double y) {
-        auto* s = static_cast<WindowState*>(glfwGetWindowUserPointer(w));
-        s->eventX = x, s->eventY = y;
+        WindowState& s = stateOf(w);
+        s.uiInput.events.push_back({UiInput::Kind::Move, x, y});
+        s.eventX = x, s.eventY = y;
+    });
+    glfwSetCharCallback(window, [](GLFWwindow* w, unsigned ch) {
+        stateOf(w).uiInput.events.push_back({UiInput::Kind::Char, 0, 0, 0, false, ch});
     });
     glfwSetMouseButtonCallback(window, [](GLFWwindow* w, int button, int action, int) {
+        WindowState& s = stateOf(w);
+        s.uiInput.events.push_back({UiInput::Kind::Button, 0, 0, button, action == GLFW_PRESS});
         if (button != GLFW_MOUSE_BUTTON_LEFT || action != GLFW_PRESS) return;
-        auto* s = static_cast<WindowState*>(glfwGetWindowUserPointer(w));
-        s->pressX = s->eventX, s->pressY = s->eventY;
-        s->pressPending = true;
+        s.pressX = s.eventX, s.pressY = s.eventY;
+        s.pressPending = true;
     });
     glfwSetKeyCallback(window, [](GLFWwindow* w, int key, int, int action, int) {
+        if (action != GLFW_REPEAT) stateOf(w).uiInput.events.push_back({UiInput::Kind::Key, 0, 0, key, action == GLFW_PRESS});
         if (action != GLFW_PRESS || ImGui::GetIO().WantCaptureKeyboard) return;
-        auto* s = static_cast<WindowState*>(glfwGetWindowUserPointer(w));
+        auto* s = &stateOf(w);
         if (key == GLFW_KEY_ESCAPE) glfwSetWindowShouldClose(w, 1);
         if (key == GLFW_KEY_F1) s->showDebug = !s->showDebug;
         if (key == GLFW_KEY_SPACE) s->app->paused = !s->app->paused;
@@ -60,14 +127,14 @@ void handleMouse(GLFWwindow* window, WindowState& state) {
     CompareView& cmp = state.compare;
     const double lineX = state.image.x + cmp.split * state.image.z;
     if (cmp.on && down && (cmp.dragging || (!state.dragging && inImage && std::abs(x - lineX) <= 6 &&
-                                            !ImGui::GetIO().WantCaptureMouse))) {
+                                            !overPanel(x, y)))) {
         cmp.dragging = true;
         cmp.split = std::clamp(float((x - state.image.x) / std::max(1, state.image.z)), 0.0f, 1.0f);
         state.lastX = x, state.lastY = y;
         return;
     }
     if (!down) cmp.dragging = false;
-    if (down && (state.dragging || (inImage && !ImGui::GetIO().WantCaptureMouse))) {
+    if (down && (state.dragging || (inImage && !overPanel(x, y)))) {
         glm::vec3 origin, dir;
         app.camera().rayThrough(x - state.image.x, y - state.image.y, state.image.z, state.image.w, origin, dir);
         if (!state.dragging) {

@@ -7,6 +7,8 @@
 #include <imgui.h>
 #include <nlohmann/json.hpp>
 
+#include <cfloat>
+#include <deque>
 #include <functional>
 #include <map>
 #include <string>
@@ -51,6 +53,30 @@ struct PipelineEditor {
     void writeBack(App& app);
 };
 
+// What ImGui is fed, in the order GLFW reported it. ImGui 1.86 predates the input queue
+// of 1.87: its backend writes key states as they come and polls the cursor and buttons
+// when a frame starts, so between two slow frames a key pressed and released is lost and
+// a click lands where the cursor went next. The queue replays one transition of each key
+// or button per frame, each at the cursor position it happened at.
+struct UiInput {
+    enum class Kind : uint8_t { Move, Button, Key, Char, Scroll };
+    struct Event {
+        Kind kind;
+        double x = 0, y = 0;  // Move: the position; Scroll: the offsets
+        int code = 0;         // the button or key
+        bool down = false;
+        unsigned ch = 0;
+    };
+    std::deque<Event> events;
+    // What ImGui has been told so far.
+    double x = -FLT_MAX, y = -FLT_MAX;
+    bool buttons[ImGuiMouseButton_COUNT] = {};
+    std::map<int, bool> keys;
+    // Feeds ImGui the events of one frame (call between the backend's NewFrame and
+    // ImGui::NewFrame, which it overrides).
+    void feed(ImGuiIO& io);
+};
+
 struct WindowState {
     App* app = nullptr;
     bool showDebug = true;
@@ -74,6 +100,8 @@ struct WindowState {
     // Int parameter values being dragged (applied on release), by "pass.param".
     std::map<std::string, ParamValue> pendingInts;
     UiProbe probe;
+    UiInput uiInput;
+    ImGuiTextFilter textureFilter;  // the Textures panel's filter
     // The resolution budget: render at renderScale × the image area; with autoScale
     // the scale follows the frame time toward budgetMs.
     float renderScale = 1.0f;

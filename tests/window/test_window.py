@@ -290,6 +290,16 @@ try:
     e = p["compare"]["errors"]
     check(p["compare"]["on"] and 0 < e["rmse"] < 10 and 0 < e["ssim"] <= 1 and e["reference_paths"] >= 8,
           "compare.json shows RMSE %.4g, SSIM %.4f against a reference of %d paths" % (e["rmse"], e["ssim"], e["reference_paths"]))
+    # Input at a slow frame rate (compare.json renders the reference: over a second a
+    # frame here): Ctrl+A and a word typed within one frame all arrive, in order. ImGui
+    # 1.86 polled key states per frame, so the Ctrl+A was lost and the word appended.
+    click("texture-filter")
+    sh("xdotool", "key", "--window", WINDOW, "ctrl+a")
+    sh("xdotool", "type", "--window", WINDOW, "--delay", "1", "albedo")
+    p = wait_for(lambda p: "texture:gbuffer.albedo" in p["widgets"] and "texture:voxelize.count" not in p["widgets"],
+                 "the filter replaced by \"albedo\"", 120)
+    check("texture:gbuffer.albedo" in p["widgets"], "Ctrl+A and \"albedo\" typed in one slow frame (%.0f ms) replace the filter"
+          % p["frame_ms"])
     ix, iy, iw, ih = p["image"]
     x, _ = centre("compare-line")
     y = iy + ih - 16  # below the texture window, which is open at the top right
