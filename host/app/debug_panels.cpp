@@ -357,6 +357,11 @@ void panelGraph(WindowState& state, bool* open) {
         }
     for (size_t i = 0; i < plan->passes.size(); ++i)
         drawNode(state, plan->passes[i], runState[plan->passes[i].id], nodePos(i), nodeSize, int(i));
+    // The graph's extent as the window's content, so it scrolls when it does not fit.
+    int rows = 1;
+    for (int r : layout.row) rows = std::max(rows, r + 1);
+    ImGui::SetCursorScreenPos(origin);
+    ImGui::Dummy(ImVec2(16 + layout.columns * (nodeSize.x + gap.x), 16 + rows * (nodeSize.y + gap.y)));
     ImGui::End();
 }
 
