@@ -78,9 +78,7 @@ bool TextureViewer::reload(const ShaderLibrary& shaders, std::string& error) {
 }
 
 bool TextureViewer::init(const ShaderLibrary& shaders, std::string& error) {
-    GLuint vao = 0;
-    glCreateVertexArrays(1, &vao);
-    vao_ = gl::VertexArrayHandle(vao);
+    vao_ = gl::createVertexArray();
     return reload(shaders, error);
 }
 
@@ -269,13 +267,12 @@ void TextureViewer::save(const run::NamedTexture& nt, const ViewSettings& s) {
     if (is3D) name += ".z" + std::to_string(slice);
     std::error_code ec;
     fs::create_directories(saveDir_, ec);
-    const fs::path base = saveDir_ / name;
+    const std::string base = (saveDir_ / name).string();
     std::string error;
+    bool withExr = false;
     if (ec) lastSaved_ = saveDir_.string() + ": cannot create: " + ec.message();
-    else if (!writePng(base.string() + ".png", img, 4, error) ||
-             (run::isFloatFormat(t.format) && !writeExr(base.string() + ".exr", img, error)))
-        lastSaved_ = error;
-    else lastSaved_ = base.string() + (run::isFloatFormat(t.format) ? ".png and .exr" : ".png");
+    else if (!run::writeTextureImage(img, t.format, base, withExr, error)) lastSaved_ = error;
+    else lastSaved_ = base + (withExr ? ".png and .exr" : ".png");
     log::info("texture window: ", lastSaved_);
 }
 

@@ -62,9 +62,8 @@ GLuint HostPassContext::framebuffer(std::initializer_list<std::string_view> colo
     key += "|" + std::string(depth) + "@" + std::to_string(mip);
     auto it = slot_.framebuffers.find(key);
     if (it == slot_.framebuffers.end()) {
-        GLuint fbo = 0;
-        glCreateFramebuffers(1, &fbo);
-        gl::FramebufferHandle handle(fbo);
+        gl::FramebufferHandle handle = gl::createFramebuffer();
+        const GLuint fbo = handle.id();
         std::vector<GLenum> drawBuffers;
         GLenum attachment = GL_COLOR_ATTACHMENT0;
         for (auto c : colors) {

@@ -41,9 +41,7 @@ bool Runtime::init(const RuntimeOptions& options, std::string& error) {
         return false;
     }
     frameUniforms_ = gl::Buffer::create(sizeof(GpuFrame), nullptr, GL_DYNAMIC_STORAGE_BIT, "kiln.frame");
-    GLuint vao = 0;
-    glCreateVertexArrays(1, &vao);
-    emptyVao_ = gl::VertexArrayHandle(vao);
+    emptyVao_ = gl::createVertexArray();
     fallbacks_.create();
     limits_ = TextureLimits::query(options.textureBudgetBytes);
     return true;

@@ -160,6 +160,12 @@ const TextureRef& FallbackTextures::get(TextureKind kind, Fallback fb) const {
     return refs_[kBlack];
 }
 
+bool writeTextureImage(const FloatImage& image, GLenum internalFormat, const std::string& base, bool& withExr,
+                       std::string& error) {
+    withExr = isFloatFormat(internalFormat);
+    return writePng(base + ".png", image, 4, error) && (!withExr || writeExr(base + ".exr", image, error));
+}
+
 bool dumpTextures(const std::vector<NamedTexture>& textures, const fs::path& dir, std::string& error) {
     std::error_code ec;
     fs::create_directories(dir, ec);
@@ -171,9 +177,8 @@ bool dumpTextures(const std::vector<NamedTexture>& textures, const fs::path& dir
         const TextureRef& r = t.ref;
         const int layer = r.target == GL_TEXTURE_3D ? r.depth / 2 : -1;
         FloatImage img = readTexture(r.id, r.target, r.format, r.width, r.height, 0, layer);
-        const std::string base = (dir / (t.pass + "." + t.name)).string();
-        if (!writePng(base + ".png", img, 4, error)) return false;
-        if (isFloatFormat(r.format) && !writeExr(base + ".exr", img, error)) return false;
+        bool withExr = false;
+        if (!writeTextureImage(img, r.format, (dir / (t.pass + "." + t.name)).string(), withExr, error)) return false;
     }
     return true;
 }

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "graph/plan.hpp"
+#include "kiln/float_image.hpp"
 #include "kiln/gl.hpp"
 #include "kiln/pass.hpp"
 
@@ -70,6 +71,12 @@ struct NamedTexture {
     TextureRef ref;
     float depthNear = 0.0f, depthFar = 0.0f;  // TextureDecl's: how to linearise a depth texture
 };
+
+// Writes `image`, read back from a texture of `internalFormat`, as BASE.png (clamped to
+// [0,1]) and, for float and depth formats, BASE.exr with the raw values. True when the
+// EXR was written too in `withExr`.
+bool writeTextureImage(const FloatImage& image, GLenum internalFormat, const std::string& base, bool& withExr,
+                       std::string& error);
 
 // Writes each texture into `dir` as PASS.NAME.png (clamped to [0,1]) and, for float
 // and depth formats, PASS.NAME.exr with the raw values. 3D textures: the middle slice

@@ -33,9 +33,8 @@ void SceneRenderer::buildMeshes(const SceneLook& look) {
     indexBuffer_ = gl::Buffer::create(static_cast<GLsizeiptr>(indices.size() * sizeof(uint32_t)), indices.data(), 0,
                                       "scene.indices");
     if (!vao_) {
-        GLuint vao = 0;
-        glCreateVertexArrays(1, &vao);
-        vao_ = gl::VertexArrayHandle(vao);
+        vao_ = gl::createVertexArray();
+        const GLuint vao = vao_.id();
         gl::label(GL_VERTEX_ARRAY, vao, "scene.vao");
         glEnableVertexArrayAttrib(vao, 0);
         glEnableVertexArrayAttrib(vao, 1);
