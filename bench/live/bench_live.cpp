@@ -64,7 +64,7 @@ int main(int argc, char** argv) {
     }
     log::setMinLevel(log::Level::Error);
     const app::EditableCopy copy(fs::temp_directory_path() / ("kiln-bench-live-" + std::to_string(getpid())),
-                                 KILN_SOURCE_DIR);
+                                 app::defaultDataRoot());
     const fs::path& root = copy.root();
     const fs::path v1 = fs::path(LIVE_MODULE_BUILDS) / "tint_v1.so", v2 = fs::path(LIVE_MODULE_BUILDS) / "tint_v2.so";
     const bool haveModules = fs::exists(v1) && fs::exists(v2);

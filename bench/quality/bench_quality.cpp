@@ -59,6 +59,7 @@
 
 #include "app/app.hpp"
 #include "app/context.hpp"
+#include "kiln/data_root.hpp"
 #include "kiln/hash.hpp"
 #include "kiln/image_io.hpp"
 #include "kiln/log.hpp"
@@ -88,8 +89,8 @@ const char* const kDefaultSweeps[] = {
 };
 
 struct Args {
-    std::string pipeline = std::string(KILN_SOURCE_DIR) + "/pipelines/default.json";
-    std::string scene = std::string(KILN_SOURCE_DIR) + "/scenes/cornell.json";
+    std::string pipeline = (app::defaultDataRoot() / "pipelines/default.json").string();
+    std::string scene = (app::defaultDataRoot() / "scenes/cornell.json").string();
     double time = 0.5;
     int width = 128, height = 128, spp = 256, frames = 5, repeats = 3;
     std::vector<std::string> sweeps;
@@ -232,10 +233,13 @@ bool referenceHalf(app::App& app, const Args& args, int half, FloatImage& out, F
     key = fnv1a(values, sizeof values, key);
     const uint64_t simState = app.scene().sim().stateHash();
     key = fnv1a(&simState, sizeof simState, key);
-    const fs::path source(KILN_SOURCE_DIR);
-    std::vector<fs::path> code = {source / "passes/reference/reference.cpp"};
+    // An installed Kiln has the module, not its source.
+    const fs::path source(KILN_SOURCE_DIR), data = app::defaultDataRoot();
+    std::vector<fs::path> code = {fs::exists(source / "passes/reference/reference.cpp")
+                                      ? source / "passes/reference/reference.cpp"
+                                      : shippedFiles().modules / "libpass_reference.so"};
     for (const char* dir : {"shaders/reference", "shaders/common"})
-        for (const auto& entry : fs::directory_iterator(source / dir)) code.push_back(entry.path());
+        for (const auto& entry : fs::directory_iterator(data / dir)) code.push_back(entry.path());
     std::sort(code.begin(), code.end());
     for (const fs::path& file : code) key = fnv1a(slurp(file.string()), key);
     char name[80];

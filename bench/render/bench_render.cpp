@@ -118,7 +118,7 @@ Args parseArgs(int argc, char** argv) {
             usageError("unknown argument \"" + a + "\"");
         }
     }
-    if (args.pipelines.empty()) args.pipelines.push_back(std::string(KILN_SOURCE_DIR) + "/pipelines/default.json");
+    if (args.pipelines.empty()) args.pipelines.push_back((app::defaultDataRoot() / "pipelines/default.json").string());
     return args;
 }
 
@@ -164,7 +164,7 @@ std::vector<Config> configsOf(const Args& args) {
     for (auto& p : args.pipelines) {
         std::string name = fs::path(p).stem().string();
         if (!args.growKind.empty()) {
-            const std::string base = args.scene.empty() ? std::string(KILN_SOURCE_DIR) + "/scenes/cornell.json" : args.scene;
+            const std::string base = args.scene.empty() ? (app::defaultDataRoot() / "scenes/cornell.json").string() : args.scene;
             for (int n : args.growCounts)
                 configs.push_back({p, args.sets, name + " " + std::to_string(n) + " " + args.growKind,
                                    grownScene(base, args.growKind, n, args.outDir), n});

@@ -341,7 +341,7 @@ int main(int argc, char** argv) {
     }
     log::setMinLevel(log::Level::Error);
 
-    const app::EditableCopy copy(fs::temp_directory_path() / ("kiln-soak-" + std::to_string(getpid())), KILN_SOURCE_DIR);
+    const app::EditableCopy copy(fs::temp_directory_path() / ("kiln-soak-" + std::to_string(getpid())), app::defaultDataRoot());
     const EditedFiles files(copy.root());
     app::Options o;
     app::applyDefaults(o);

@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <string_view>
 
+#include "kiln/data_root.hpp"
+
 namespace kiln::app {
 
 const char* kUsage = R"(kiln — a render-pass framework with hot reload
@@ -18,6 +20,9 @@ usage: kiln [options]
   --size WxH        output size (default 720x720)
   --frames N        frames to render in headless mode (default 1)
   --out FILE.png    write the final image (headless)
+  --watch           headless: keep running after --frames frames, rewrite --out
+                    (and --dump) after every frame in which a live edit landed,
+                    until interrupted (SIGINT/SIGTERM); a preview for an image viewer
   --dump DIR        headless: write every texture of the last frame (PNG, and OpenEXR for
                     float/depth); window: where the texture window's "save" writes
                     (default ./kiln-saves)
@@ -38,9 +43,10 @@ usage: kiln [options]
                     S seconds is interrupted and named (default 10; 0: never)
   --seed N          simulation seed (same seed, same frames)
   --paused          do not advance the simulation
-  --shaders DIRS    shader roots, ':'-separated, the first that has a file wins
-                    (default shaders/, see below); all are watched
-  --modules DIRS    pass module directories, ':'-separated (default: the build's modules/)
+  --shaders DIRS    shader roots, ':'-separated, the first that has a file wins,
+                    all watched; an empty entry is the shipped shaders/ (see
+                    below): "--shaders mine:" searches mine/, then them
+  --modules DIRS    pass module directories, the same way ("--modules mine:")
   --help            this text
 
 Window keys and mouse:
@@ -68,21 +74,40 @@ std::filesystem::path defaultDataRoot() {
     // A copied tree edits and writes back its own files, not the ones it was built from.
     if (!ec && fs::is_regular_file(cwd / "pipelines/default.json", ec) && fs::is_regular_file(cwd / "shaders/common/frame.glsl", ec))
         return cwd;
-    return KILN_SOURCE_DIR;
+    return shippedFiles().data;
 }
+
+namespace {
+
+// An empty entry in a ':'-separated list stands for the shipped directory, as in MANPATH:
+// "--shaders mine:" searches mine/, then the shipped shaders; "--shaders mine" only mine/
+// (a file missing there is an error, never a silent fall-back to the shipped copy).
+std::string withShipped(const std::string& list, const std::string& shipped) {
+    if (list.empty()) return shipped;
+    std::string out;
+    for (size_t start = 0; start <= list.size();) {
+        const size_t end = std::min(list.find(':', start), list.size());
+        if (start > 0) out += ':';
+        out += end > start ? list.substr(start, end - start) : shipped;
+        start = end + 1;
+    }
+    return out;
+}
+
+}  // namespace
 
 void applyDefaults(Options& o) {
     const std::filesystem::path root = defaultDataRoot();
     if (o.pipeline.empty()) o.pipeline = (root / "pipelines/default.json").string();
     if (o.scene.empty()) o.scene = (root / "scenes/cornell.json").string();
-    if (o.shaderRoot.empty()) o.shaderRoot = (root / "shaders").string();
-    if (o.moduleDir.empty()) o.moduleDir = KILN_MODULE_DIR;
+    o.shaderRoot = withShipped(o.shaderRoot, (root / "shaders").string());
+    o.moduleDir = withShipped(o.moduleDir, shippedFiles().modules.string());
 }
 
 std::string usage() {
-    return std::string(kUsage) + "\nDefault files come from " + defaultDataRoot().string() +
-           "\n  (the working directory when it has pipelines/default.json and shaders/, else the source tree\n"
-           "  Kiln was built from); modules from " + KILN_MODULE_DIR + "\n";
+    return std::string(kUsage) + "\nDefault pipeline, scene and shaders come from " + defaultDataRoot().string() +
+           "\n  (the working directory when it has pipelines/default.json and shaders/, else " +
+           shippedFiles().describe() + ")\n";
 }
 
 namespace {
@@ -96,7 +121,8 @@ struct Switch {
 constexpr Switch kSwitches[] = {{"--help", &Options::help, true},        {"-h", &Options::help, true},
                                 {"--headless", &Options::headless, true}, {"--stats", &Options::stats, true},
                                 {"--no-live", &Options::live, false},     {"--no-skip", &Options::noSkip, true},
-                                {"--plan", &Options::printPlan, true},    {"--paused", &Options::paused, true}};
+                                {"--plan", &Options::printPlan, true},    {"--paused", &Options::paused, true},
+                                {"--watch", &Options::watch, true}};
 
 // Options whose value is kept as text (paths, a texture name).
 struct TextOption {
@@ -178,6 +204,11 @@ std::optional<Options> parseOptions(int argc, char** argv, std::string& error) {
         const std::string v = argv[++i];
         if (text != std::end(kTextOptions)) o.*(text->field) = v;
         else if (a == "--size" ? !parseSize(v, o, error) : !parseNumber(a, v, o, error)) return std::nullopt;
+    }
+    if (o.watch && (!o.headless || !o.live || (o.out.empty() && o.dump.empty()))) {
+        error = "--watch keeps a headless run going and rewrites its files after each live edit: it needs --headless "
+                "and --out or --dump, and not --no-live";
+        return std::nullopt;
     }
     return o;
 }

@@ -13,8 +13,8 @@ inline constexpr uint64_t kSceneSeed = ~0ull;
 struct Options {
     std::string pipeline;     // default: <source>/pipelines/default.json
     std::string scene;        // default: <source>/scenes/cornell.json
-    std::string shaderRoot;   // ':'-separated roots; default: <source>/shaders
-    std::string moduleDir;    // default: the build's modules directory
+    std::string shaderRoot;   // ':'-separated roots; an empty entry: the shipped shaders/
+    std::string moduleDir;    // ':'-separated; an empty entry: the shipped modules
     bool headless = false;
     int width = 720, height = 720;
     int frames = 1;
@@ -26,6 +26,7 @@ struct Options {
     std::string dot;          // write the plan as graphviz
     uint64_t seed = kSceneSeed;  // kSceneSeed: the scene file's physics.seed
     bool live = true;         // watch files and reload them while running
+    bool watch = false;       // headless: run until interrupted, rewrite the outputs after each reload
     bool paused = false;      // freeze the simulation (time stays at 0 + frames×0)
     bool help = false;
     std::string screenshot;   // window: save the window after --frames frames and quit
@@ -40,10 +41,12 @@ extern const char* kUsage;
 // Parses argv; on a bad argument returns nullopt and sets `error` to one line.
 std::optional<Options> parseOptions(int argc, char** argv, std::string& error);
 // Where unset paths point: the working directory when it holds a Kiln tree
-// (pipelines/default.json and shaders/), else the source tree Kiln was built from.
+// (pipelines/default.json and shaders/), else the shipped files (kiln/data_root.hpp:
+// the installation's, or the source tree's for a build-tree kiln).
 std::filesystem::path defaultDataRoot();
-// Fills unset paths: pipelines/default.json, scenes/cornell.json and shaders/ under
-// defaultDataRoot(), and the build's modules/ directory.
+// Fills unset paths: pipelines/default.json and scenes/cornell.json under
+// defaultDataRoot(); its shaders/ and the shipped modules where the lists are empty or
+// have an empty entry.
 void applyDefaults(Options&);
 // kUsage and where the defaults come from on this machine.
 std::string usage();

@@ -25,6 +25,7 @@ public:
     int poll(App& app);
     // Counters for tests and the debug view.
     int shaderReloads = 0, pipelineReloads = 0, sceneReloads = 0, moduleReloads = 0, failures = 0;
+    int applied() const { return shaderReloads + pipelineReloads + sceneReloads + moduleReloads; }
 
     // A module file that fails the ELF check may still be being written (a build cut in
     // the middle of writing, a copy in chunks): it is re-checked on the following polls

@@ -3,9 +3,11 @@
 #include <GLFW/glfw3.h>
 
 #include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <thread>
 
 #include "app/app.hpp"
 #include "app/cli.hpp"
@@ -25,6 +27,52 @@ int fail(const std::string& message) {
     return 1;
 }
 
+// --out and --dump from the frame just rendered.
+bool writeOutputs(App& app, const Options& o, std::string& error) {
+    glFinish();
+    if (!o.out.empty()) {
+        const TextureRef* out = app.displayedTexture();
+        if (!out) {
+            error = "the pipeline produced no output texture";
+            return false;
+        }
+        FloatImage img = readTexture(out->id, out->target, out->format, out->width, out->height);
+        if (!writePng(o.out, img, 3, error)) return false;
+        log::info("wrote ", o.out, " (", img.width, "x", img.height, ")");
+    }
+    if (!o.dump.empty()) {
+        if (!app.runtime().dump(o.dump, error)) return false;
+        log::info("dumped ", app.runtime().textures().size(), " textures to ", o.dump);
+    }
+    return true;
+}
+
+volatile std::sig_atomic_t stopWatching = 0;
+
+// --watch: frames go on (paced to ~60 a second, so an idle watch costs little) until
+// SIGINT or SIGTERM; the outputs are rewritten after each frame in which an edit landed.
+// A failed edit is reported by the live reloader and leaves the files as they were.
+int watch(App& app, const Options& o) {
+    struct sigaction stop {};
+    stop.sa_handler = [](int) { stopWatching = 1; };
+    sigaction(SIGINT, &stop, nullptr);
+    sigaction(SIGTERM, &stop, nullptr);
+    log::info("watching for edits; the outputs are rewritten after each one (stop with Ctrl+C)");
+    int applied = app.live().applied();
+    while (!stopWatching) {
+        const auto next = std::chrono::steady_clock::now() + std::chrono::milliseconds(16);
+        app.frame();
+        if (app.live().applied() != applied) {
+            applied = app.live().applied();
+            std::string error;
+            if (!writeOutputs(app, o, error)) log::error(error);
+        }
+        std::this_thread::sleep_until(next);
+    }
+    log::info("stopped watching");
+    return 0;
+}
+
 int runHeadless(const Options& o) {
     std::string error;
     auto context = HeadlessContext::create(/*debug=*/true, error);
@@ -35,21 +83,10 @@ int runHeadless(const Options& o) {
 
     app.runtime().alwaysRun = o.noSkip;
     for (int f = 0; f < o.frames; ++f) app.frame();
-    glFinish();
     app.runtime().collectGpuTimes();
-
-    if (!o.out.empty()) {
-        const TextureRef* out = app.displayedTexture();
-        if (!out) return fail("the pipeline produced no output texture");
-        FloatImage img = readTexture(out->id, out->target, out->format, out->width, out->height);
-        if (!writePng(o.out, img, 3, error)) return fail(error);
-        log::info("wrote ", o.out, " (", img.width, "x", img.height, ")");
-    }
-    if (!o.dump.empty()) {
-        if (!app.runtime().dump(o.dump, error)) return fail(error);
-        log::info("dumped ", app.runtime().textures().size(), " textures to ", o.dump);
-    }
+    if (!writeOutputs(app, o, error)) return fail(error);
     if (o.stats) std::printf("%s", app.runtime().statsTable().c_str());
+    if (o.watch) return watch(app, o);
     // Each error was printed when it arose; this line only says why the exit status is 1.
     if (const size_t standing = app.runtime().activeErrors().size())
         return fail(str(standing, standing == 1 ? " error" : " errors", " still standing after the last frame (above)"));

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "bench.hpp"
+#include "kiln/data_root.hpp"
 #include "kiln/sim/world.hpp"
 
 using namespace kiln::sim;
@@ -96,7 +97,7 @@ int main(int argc, char** argv) {
     const std::string command = args[0];
     if (command != "run" && command != "bench") return fail("unknown command \"" + command + "\"; see kiln-sim --help");
 
-    std::string scenePath = std::string(KILN_SOURCE_DIR) + "/scenes/cornell.json", outDir = "bench-out", mode, contact;
+    std::string scenePath = (kiln::shippedFiles().data / "scenes/cornell.json").string(), outDir = "bench-out", mode, contact;
     long long steps = 1000, seed = -1;
     bool quick = false;
     for (size_t i = 1; i < args.size(); ++i) {

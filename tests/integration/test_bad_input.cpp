@@ -85,7 +85,7 @@ TEST_CASE("bad command-line values", "[integration][cli][robust]") {
     for (const char* args : {"--size 0x0", "--size -5x5", "--size 100000x100000", "--size 12", "--size", "--frames -3",
                              "--frames", "--frames 1x", "--frames 4294967297", "--frames 2147483648", "--frames 99999999999999999999", "--bogus", "--pipeline", "--seed banana",
                              "--budget -1", "--budget fast", "--budget", "--ui-probe", "--watchdog -1", "--watchdog 86401",
-                             "--watchdog 1.5"}) {
+                             "--watchdog 1.5", "--watch", "--watch --out w.png --no-live"}) {
         const Run r = runKiln(std::string("--headless ") + args, 60);
         INFO(args << "\n" << r.err);
         CHECK(r.exitCode == 1);
@@ -172,7 +172,7 @@ TEST_CASE("bad shader roots", "[integration][robust]") {
 }
 
 TEST_CASE("bad module directories", "[integration][robust]") {
-    const std::string real = KILN_MODULE_DIR;
+    const std::string real = KILN_BUILD_MODULE_DIR;
     auto with = [&](const fs::path& d) { return "--modules " + (d / "m").string() + ":" + real; };
     const std::vector<Case> cases = {
         {"modules-missing", [](const fs::path& d) { return "--modules " + (d / "none").string(); },
@@ -204,7 +204,7 @@ TEST_CASE("bad module directories", "[integration][robust]") {
 // A pass module with a bug in one of its entry points (tests/core/modules/faulty.cpp,
 // the bug chosen by KILN_TEST_FAULT): one named error, exit 1, never a signal or a hang.
 TEST_CASE("modules that crash, abort, throw or loop", "[integration][robust][guard]") {
-    const std::string modules = "--modules " + std::string(TEST_MODULE_DIR) + ":" + KILN_MODULE_DIR;
+    const std::string modules = "--modules " + std::string(TEST_MODULE_DIR) + ":" + KILN_BUILD_MODULE_DIR;
     auto setup = [&](const fs::path& d) {
         write(d / "faulty.json", R"({"output": "bad.color", "passes": [{"id": "bad", "module": "test_faulty"}]})");
         return modules + " --watchdog 1 --pipeline " + (d / "faulty.json").string();

@@ -137,7 +137,7 @@ TEST_CASE("bad command lines exit non-zero with one line on stderr", "[integrati
     }
 }
 
-TEST_CASE("default files come from a Kiln tree in the working directory, else the source tree", "[integration][cli]") {
+TEST_CASE("default files come from a Kiln tree in the working directory, else the source tree, and an empty list entry is the shipped one", "[integration][cli]") {
     // A copied tree whose pipeline is broken: run from inside the copy, kiln must read
     // (and name) the copy's file, not the source tree's it was built from.
     const fs::path copy = fs::path(TEST_OUTPUT_DIR) / ("tree-copy-" + std::to_string(getpid()));
@@ -151,7 +151,7 @@ TEST_CASE("default files come from a Kiln tree in the working directory, else th
     CHECK(inCopy.exitCode == 1);
     CHECK_THAT(inCopy.err, Catch::Contains((copy / "pipelines/default.json").string()));
     const Run help = runKiln("--help", 60, copy.string());
-    CHECK_THAT(help.out, Catch::Contains("Default files come from " + copy.string()));
+    CHECK_THAT(help.out, Catch::Contains("Default pipeline, scene and shaders come from " + copy.string()));
 
     // Outside any tree: the source tree's files, which render.
     const fs::path empty = fs::path(TEST_OUTPUT_DIR) / ("no-tree-" + std::to_string(getpid()));
@@ -160,6 +160,18 @@ TEST_CASE("default files come from a Kiln tree in the working directory, else th
     INFO(outside.err);
     CHECK(outside.exitCode == 0);
     CHECK(fs::file_size(empty / "o.png") > 0);
+    CHECK_THAT(runKiln("--help", 60, empty.string()).out,
+               Catch::Contains("the source tree Kiln was built from, " + std::string(KILN_SOURCE_DIR)));
+
+    // An empty entry in --shaders/--modules stands for the shipped directory: a list of
+    // an empty directory and it renders; the same list without it finds no pass.
+    const std::string lists = " --shaders " + empty.string() + ": --modules " + empty.string();
+    const Run withShipped = runKiln("--headless --size 16x16" + lists + ":", 120, empty.string());
+    INFO(withShipped.err);
+    CHECK(withShipped.exitCode == 0);
+    const Run without = runKiln("--headless --size 16x16" + lists, 120, empty.string());
+    CHECK(without.exitCode == 1);
+    CHECK_THAT(without.err, Catch::Contains("no module \"gbuffer\""));
     fs::remove_all(copy);
     fs::remove_all(empty);
 }

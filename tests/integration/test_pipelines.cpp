@@ -14,7 +14,7 @@ namespace fs = std::filesystem;
 using namespace kiln;
 
 TEST_CASE("every shipped pipeline compiles against the real modules, without warnings", "[integration][files]") {
-    run::ModuleRegistry modules({fs::path(KILN_MODULE_DIR)});
+    run::ModuleRegistry modules({fs::path(KILN_BUILD_MODULE_DIR)});
     graph::CompileOptions options;
     options.resolve = [&](const std::string& m) { return modules.declaration(m); };
     options.availableModules = modules.loader().available();

@@ -13,9 +13,7 @@
 #include <string>
 #include <vector>
 
-#ifndef KILN_PLOT_SCRIPT
-#error "KILN_PLOT_SCRIPT must name scripts/plot.py (link the kiln_plot target)"
-#endif
+#include "kiln/data_root.hpp"
 
 extern char** environ;
 
@@ -24,7 +22,7 @@ namespace kiln {
 // Runs `plot.py arguments...` and waits for it. On failure returns false and says why in
 // `error` (the script's own message went to stderr); the CSV it was given stays.
 inline bool drawPlot(const std::vector<std::string>& arguments, std::string& error) {
-    const std::string python = "/usr/bin/python3", script = KILN_PLOT_SCRIPT;
+    const std::string python = "/usr/bin/python3", script = (shippedFiles().data / "scripts/plot.py").string();
     std::vector<std::string> words{python, script};
     words.insert(words.end(), arguments.begin(), arguments.end());
     std::vector<char*> argv;
