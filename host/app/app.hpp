@@ -36,6 +36,8 @@ public:
     int lastSteps = 0;          // steps taken in the last frame
     double lastStepMs = 0;      // what they cost, in all
     double droppedSeconds = 0;  // simulated time given up to the budget since the last reset or reload
+    // The camera's view-projection of the last frame built (what its textures hold).
+    const glm::mat4& viewProj() const { return lastViewProj_; }
     // The graph output, or the texture chosen with --view / in the debug view.
     const TextureRef* displayedTexture() const;
 

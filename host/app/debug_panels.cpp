@@ -267,7 +267,7 @@ void panelScene(WindowState& state) {
     ImGui::Checkbox("resolution follows the budget", &state.autoScale);
     if (ImGui::IsItemHovered()) ImGui::SetTooltip("lowers the render resolution while frames take longer than the budget");
     ImGui::SetNextItemWidth(120);
-    if (ImGui::SliderFloat("budget ms", &state.budgetMs, 16.0f, 500.0f, "%.0f")) state.scaleFloor = 0.125f;
+    if (ImGui::SliderFloat("budget ms", &state.budgetMs, 16.0f, 500.0f, "%.0f")) state.scaleFloor = WindowState::kAutoScaleFloor;
     if (!state.autoScale) ImGui::SliderFloat("resolution scale", &state.renderScale, 0.125f, 1.0f, "%.3f");
     else ImGui::Text("resolution scale %.3f", state.renderScale);
     ImGui::TextDisabled("drag a tumbler: low to move it, high to tilt it");
@@ -403,6 +403,7 @@ void drawSidebar(WindowState& state) {
     if (ImGui::Begin("Scene")) panelScene(state);
     ImGui::End();
     if (state.showGraph) panelGraph(state, &state.showGraph);
+    panelTrace(state);
     if (state.compare.on) {
         state.compare.panel(app, ImGui::GetTime(), {state.image.x + 8, state.image.y + 8}, [&](const std::string& id) { state.probe.item(id); });
         // The line, over the image; drag it (handleMouse).
@@ -423,6 +424,57 @@ void drawSidebar(WindowState& state) {
             if (const glm::vec4 b = state.viewer.saveButtonRect(); state.probe.on() && b.z > b.x)
                 state.probe.widgets["texture-save"] = {b.x, b.y, b.z, b.w};
         }
+}
+
+// The pixel trace's window: one row per texture (per tile of a tiled 3D atlas), passes in
+// the order they ran; a texture's name selects it in the texture window. A cross marks
+// the pixel on the image.
+void panelTrace(WindowState& state) {
+    App& app = *state.app;
+    if (!state.showTrace || !state.traceUv) return;
+    state.trace = tracePixel(app.runtime(), glm::inverse(app.viewProj()), *state.traceUv);
+    const PixelTrace& t = state.trace;
+    const float cx = float(state.image.x) + t.uv.x * float(state.image.z), cy = float(state.image.y) + (1.0f - t.uv.y) * float(state.image.w);
+    ImDrawList* fg = ImGui::GetForegroundDrawList();
+    fg->AddLine(ImVec2(cx - 8, cy), ImVec2(cx + 8, cy), IM_COL32(255, 80, 200, 255), 1.5f);
+    fg->AddLine(ImVec2(cx, cy - 8), ImVec2(cx, cy + 8), IM_COL32(255, 80, 200, 255), 1.5f);
+    ImGui::SetNextWindowPos(ImVec2(float(state.image.x + state.image.z) - 470, float(state.image.y + state.image.w) - 330), ImGuiCond_FirstUseEver);
+    ImGui::SetNextWindowSize(ImVec2(460, 320), ImGuiCond_FirstUseEver);
+    if (ImGui::Begin("Pixel trace (right-click the image)", &state.showTrace)) {
+        const TextureRef* out = app.runtime().outputTexture();
+        ImGui::Text("pixel (%d, %d) of the output", out ? int(t.uv.x * float(out->width)) : 0, out ? int(t.uv.y * float(out->height)) : 0);
+        if (t.world) ImGui::Text("world (%.3f, %.3f, %.3f) from %s", t.world->x, t.world->y, t.world->z, t.depthTexture.c_str());
+        else ImGui::TextDisabled("%s", t.depthTexture.empty() ? "no camera depth in this graph: 3D textures unread" : "the pixel sees no surface");
+        const ImGuiTableFlags flags = ImGuiTableFlags_RowBg | ImGuiTableFlags_BordersInnerV | ImGuiTableFlags_ScrollY | ImGuiTableFlags_Resizable;
+        if (ImGui::BeginTable("trace", 4, flags)) {
+            ImGui::TableSetupScrollFreeze(0, 1);
+            for (const char* column : {"pass", "texture", "texel", "value"}) ImGui::TableSetupColumn(column);
+            ImGui::TableHeadersRow();
+            std::string lastPass;
+            for (const TraceRow& r : t.rows) {
+                ImGui::TableNextRow();
+                ImGui::TableNextColumn();
+                if (r.pass != lastPass) ImGui::TextUnformatted(r.pass.c_str());
+                lastPass = r.pass;
+                ImGui::TableNextColumn();
+                const std::string name = r.pass + "." + r.name;
+                const std::string label = r.name + (r.tile >= 0 ? "[" + std::to_string(r.tile) + "]" : "") + "##" + name + std::to_string(r.tile);
+                if (ImGui::Selectable(label.c_str(), app.viewed == name)) app.viewed = name, state.showTexture = true;
+                ImGui::TableNextColumn();
+                if (r.volume) ImGui::Text("%d,%d,%d", r.texel.x, r.texel.y, r.texel.z);
+                else ImGui::Text("%d,%d", r.texel.x, r.texel.y);
+                ImGui::TableNextColumn();
+                if (r.read) ImGui::Text("%.4g %.4g %.4g %.4g", r.value.r, r.value.g, r.value.b, r.value.a);
+                else ImGui::TextDisabled("-");
+            }
+            ImGui::EndTable();
+        }
+        if (state.probe.on()) {
+            const ImVec2 p = ImGui::GetWindowPos(), size = ImGui::GetWindowSize();
+            state.probe.widgets["trace-window"] = {p.x, p.y, p.x + size.x, p.y + size.y};
+        }
+    }
+    ImGui::End();
 }
 
 namespace {

@@ -43,6 +43,15 @@ nlohmann::json probeState(const WindowState& state, uint64_t frame) {
     }
     if (const auto& f = state.viewer.lastFit()) j["fit"] = {f->min, f->max};
     if (!state.viewer.lastSaved().empty()) j["saved"] = state.viewer.lastSaved();
+    if (state.showTrace && state.traceUv) {
+        const PixelTrace& t = state.trace;
+        nlohmann::json rows = nlohmann::json::array();
+        for (const TraceRow& r : t.rows)
+            rows.push_back({{"texture", r.pass + "." + r.name}, {"tile", r.tile}, {"texel", {r.texel.x, r.texel.y, r.texel.z}},
+                            {"read", r.read}, {"value", {r.value.r, r.value.g, r.value.b, r.value.a}}});
+        j["trace"] = {{"uv", {t.uv.x, t.uv.y}}, {"depth", t.depthTexture}, {"rows", rows}};
+        if (t.world) j["trace"]["world"] = {t.world->x, t.world->y, t.world->z};
+    }
     j["compare"] = {{"on", state.compare.on}, {"split", state.compare.split}};
     if (const auto& e = state.compare.errors())
         j["compare"]["errors"] = {{"rmse", e->rmse}, {"rel_mse", e->relMse}, {"psnr", e->psnr}, {"ssim", e->ssim},

@@ -20,8 +20,6 @@
 
 namespace kiln::app {
 
-namespace {
-
 namespace fs = std::filesystem;
 
 // The resolution budget: steps of 0.8 / 1.25, at most one a second (and six frames), so
@@ -52,6 +50,8 @@ void followBudget(WindowState& state, double now) {
         state.lastScaleChange = now;
     }
 }
+
+namespace {
 
 // $XDG_CONFIG_HOME/kiln/imgui.ini (else ~/.config/kiln/imgui.ini); "" when there is
 // no such directory and it cannot be made (then nothing persists).

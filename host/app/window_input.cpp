@@ -88,6 +88,10 @@ void installCallbacks(GLFWwindow* window) {
     glfwSetMouseButtonCallback(window, [](GLFWwindow* w, int button, int action, int) {
         WindowState& s = stateOf(w);
         s.uiInput.events.push_back({UiInput::Kind::Button, 0, 0, button, action == GLFW_PRESS});
+        if (button == GLFW_MOUSE_BUTTON_RIGHT && action == GLFW_PRESS) {
+            s.traceX = s.eventX, s.traceY = s.eventY;
+            s.tracePending = true;
+        }
         if (button != GLFW_MOUSE_BUTTON_LEFT || action != GLFW_PRESS) return;
         s.pressX = s.eventX, s.pressY = s.eventY;
         s.pressPending = true;
@@ -106,6 +110,7 @@ void installCallbacks(GLFWwindow* window) {
     });
 }
 
+// Right button on the image: trace that pixel through the graph (panelTrace).
 // Left button: on a tumbler it drags it (grabbed below its centre of mass it slides on
 // the floor, above it tilts and rolls: the README's keys); on empty space it orbits
 // the camera.
@@ -120,6 +125,17 @@ void handleMouse(GLFWwindow* window, WindowState& state) {
         x = state.pressX, y = state.pressY;
     }
     state.pressPending = false;
+    auto inImageAt = [&](double px, double py) {
+        return px >= state.image.x && py >= state.image.y && px < state.image.x + state.image.z &&
+               py < state.image.y + state.image.w && !overPanel(px, py);
+    };
+    if (state.tracePending && inImageAt(state.traceX, state.traceY)) {
+        // The centre of the window pixel under the cursor, y up.
+        state.traceUv = glm::vec2((state.traceX - state.image.x + 0.5) / state.image.z,
+                                  1.0 - (state.traceY - state.image.y + 0.5) / state.image.w);
+        state.showTrace = true;
+    }
+    state.tracePending = false;
     const bool inImage = x >= state.image.x && y >= state.image.y && x < state.image.x + state.image.z &&
                          y < state.image.y + state.image.w;
     auto& sim = app.scene().sim();

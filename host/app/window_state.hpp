@@ -11,11 +11,13 @@
 #include <deque>
 #include <functional>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "app/app.hpp"
 #include "app/compare_view.hpp"
+#include "app/pixel_trace.hpp"
 #include "app/texture_viewer.hpp"
 #include "graph/pipeline.hpp"
 
@@ -94,6 +96,13 @@ struct WindowState {
     double eventX = 0, eventY = 0;  // the cursor as of the last motion event handled
                                     // (glfwGetCursorPos is the pointer now, later events included)
     glm::ivec4 image{0};              // where the image is, window pixels from the top left
+    // The pixel trace: a right click on the image picks the pixel (traced every frame
+    // while its window is open, so the values follow the scene).
+    bool tracePending = false;
+    double traceX = 0, traceY = 0;    // where the right button went down
+    std::optional<glm::vec2> traceUv;
+    bool showTrace = false;
+    PixelTrace trace;
     TextureViewer viewer;
     CompareView compare;
     PipelineEditor editor;
@@ -110,13 +119,21 @@ struct WindowState {
     double frameMs = 0.0;             // smoothed wall time per frame
     double lastScaleChange = 0.0;
     double msBeforeDecrease = 0.0;    // frame time before the last step down (0: none pending)
-    float scaleFloor = 0.125f;        // below this, fewer pixels stopped buying time
+    // The budget never takes the image below half size on its own (a busy machine would
+    // otherwise leave a pixelated first image); the slider, with the budget off, goes to 1/8.
+    static constexpr float kAutoScaleFloor = 0.5f;
+    float scaleFloor = kAutoScaleFloor;  // raised where fewer pixels stopped buying time
     std::vector<std::string> pipelines;  // *.json beside the running pipeline
 };
+
+// window.cpp: moves renderScale toward the budget after a frame ending at `now` seconds
+// (frameMs already updated); never below scaleFloor on its own.
+void followBudget(WindowState&, double now);
 
 // debug_panels.cpp: the sidebar's panels, the error overlay, the image.
 void drawSidebar(WindowState&);
 void panelErrors(const App&, WindowState&);
+void panelTrace(WindowState&);
 void drawImage(WindowState&, int framebufferWidth, int framebufferHeight);
 
 // window_input.cpp: keys, wheel and button events, and the left button's drags.

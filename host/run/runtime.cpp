@@ -465,7 +465,7 @@ std::optional<NamedTexture> Runtime::namedTexture(std::string_view qualified) co
         auto it = s->textures.find(qualified.substr(dot + 1));
         if (it == s->textures.end()) return std::nullopt;
         const PooledTexture& t = it->second;
-        return NamedTexture{s->id, it->first, t.internal, t.ref, t.decl.depthNear, t.decl.depthFar};
+        return NamedTexture{s->id, it->first, t.internal, t.ref, t.decl.depthNear, t.decl.depthFar, t.decl.size.tiles};
     }
     return std::nullopt;
 }
@@ -479,7 +479,7 @@ std::vector<PassRow> Runtime::stats() const {
 std::vector<NamedTexture> Runtime::textures() const {
     std::vector<NamedTexture> out;
     for (auto& s : slots_)
-        for (auto& [name, t] : s->textures) out.push_back({s->id, name, t.internal, t.ref, t.decl.depthNear, t.decl.depthFar});
+        for (auto& [name, t] : s->textures) out.push_back({s->id, name, t.internal, t.ref, t.decl.depthNear, t.decl.depthFar, t.decl.size.tiles});
     return out;
 }
 

@@ -70,6 +70,7 @@ struct NamedTexture {
     bool internal;
     TextureRef ref;
     float depthNear = 0.0f, depthFar = 0.0f;  // TextureDecl's: how to linearise a depth texture
+    int tiles = 1;                             // blocks side by side along x (SizeRule::tiles)
 };
 
 // Writes `image`, read back from a texture of `internalFormat`, as BASE.png (clamped to

@@ -8,6 +8,8 @@
 #include <sstream>
 
 #include "app/app.hpp"
+#include "app/pixel_trace.hpp"
+#include "app/window_state.hpp"
 #include "kiln/image_io.hpp"
 #include "support/headless.hpp"
 
@@ -276,4 +278,73 @@ TEST_CASE("the window's clock keeps real time while stepping fits its budget, an
     app.scene().reset();
     app.frame(0.0);
     CHECK(app.droppedSeconds == 0.0);
+}
+
+TEST_CASE("the resolution budget never halves the image on its own, and comes back when frames are cheap", "[runtime]") {
+    app::WindowState state;
+    state.budgetMs = 16.0f;
+    state.frameMs = 1000.0;  // far over the budget, and fewer pixels do not help
+    double now = 0.0;
+    float lowest = 1.0f;
+    for (int frame = 0; frame < 200; ++frame, now += 1.0) {  // a second a frame: every frame may step
+        app::followBudget(state, now);
+        lowest = std::min(lowest, state.renderScale);
+    }
+    CHECK(lowest < 0.6f);   // it did step down,
+    CHECK(lowest >= 0.5f);  // but not below half size
+    state.frameMs = 1.0;    // cheap frames: back to full size
+    for (int frame = 0; frame < 200; ++frame, now += 1.0) app::followBudget(state, now);
+    CHECK(state.renderScale == 1.0f);
+}
+
+TEST_CASE("a pixel traced through the graph: each 2D texture where the pixel falls in it, the 3D ones at its world position",
+          "[runtime][gl]") {
+    constexpr int kSize = 32, kX = 22, kY = 24;  // high on the back wall right of the lamp, y up; nothing there at t = 0
+    Fixture f(kSize);
+    f.app.frame();
+    const glm::vec2 uv((kX + 0.5f) / kSize, (kY + 0.5f) / kSize);
+    const app::PixelTrace trace = app::tracePixel(f.app.runtime(), glm::inverse(f.app.viewProj()), uv);
+
+    // The world position, another way: the camera's ray through that pixel meets the back
+    // wall z = −1. Tolerance 2 mm: depth quantisation is ~0.1 mm here; half a pixel off
+    // would be ~5 cm.
+    CHECK(trace.depthTexture == "gbuffer.depth");
+    REQUIRE(trace.world);
+    glm::vec3 origin, direction;
+    f.app.camera().rayThrough(kX, kSize - 1 - kY, kSize, kSize, origin, direction);
+    const glm::vec3 onWall = origin + direction * ((-1.0f - origin.z) / direction.z);
+    REQUIRE(std::max(std::abs(onWall.x), std::abs(onWall.y)) < 0.95f);  // the pixel is on the back wall
+    INFO("traced " << trace.world->x << "," << trace.world->y << "," << trace.world->z << "; ray " << onWall.x << ","
+                   << onWall.y << "," << onWall.z);
+    CHECK(glm::length(*trace.world - onWall) < 2e-3f);
+
+    // Every texture of the plan appears; 2D values equal a whole-texture read-back at the
+    // texel the pixel falls in (full size: the pixel itself; the half-size bloom: half).
+    std::set<std::string> traced;
+    int full = 0, half = 0, tiledRows = 0;
+    for (const app::TraceRow& r : trace.rows) {
+        traced.insert(r.pass + "." + r.name);
+        const TextureRef* t = f.app.runtime().findTexture(r.pass, r.name);
+        REQUIRE(t);
+        INFO(r.pass << "." << r.name);
+        if (!r.volume) {
+            CHECK(r.texel == glm::ivec3(int(uv.x * t->width), int(uv.y * t->height), 0));
+            full += t->width == kSize && r.texel == glm::ivec3(kX, kY, 0);
+            half += t->width == kSize / 2 && r.texel == glm::ivec3(kX / 2, kY / 2, 0);
+            const FloatImage whole = readTexture(t->id, t->target, t->format, t->width, t->height);
+            for (int c = 0; c < whole.channels && c < 4; ++c) CHECK(r.value[c] == whole.at(r.texel.x, r.texel.y)[c]);
+            continue;
+        }
+        REQUIRE(r.read);
+        // Blocks are cubes of the texture's height, side by side along x.
+        const glm::ivec3 voxel = glm::ivec3((*trace.world + 1.0f) * 0.5f * float(t->height));
+        CHECK(r.texel == glm::ivec3(voxel.x + std::max(r.tile, 0) * t->height, voxel.y, voxel.z));
+        tiledRows += r.tile >= 0;
+        if (r.pass == "voxelize" && r.name == "radiance") CHECK(r.value.a > 0.0f);  // the wall's voxel is occupied
+    }
+    for (const auto& t : f.app.runtime().textures())
+        if (t.ref.bound) CHECK(traced.count(t.pass + "." + t.name) == 1);
+    CHECK(full >= 4);   // gbuffer's outputs, composite's
+    CHECK(half >= 1);   // bloom at half resolution
+    CHECK(tiledRows >= 12);  // the fixed cones' atlas, one row per direction
 }

@@ -326,6 +326,29 @@ try:
     check(not p["compare"]["on"], "leaving compare.json turns the compare view off")
     check(not any("reference" in e for e in p["errors"]), "no error about the reference's textures: %s" % p["errors"])
 
+    # 11. A pixel traced through the graph: a right click on the image lists every
+    #     texture's value there; the output's row is the pixel the screen shows.
+    ix, iy, iw, ih = p["image"]
+    x, y = ix + iw // 3, iy + ih - 24  # the floor, clear of the texture window (top right)
+    on_screen = screen_pixel(x, y, screenshot("before-trace.png"))
+    sh("xdotool", "mousemove", "--window", WINDOW, str(x), str(y))
+    time.sleep(0.2)
+    sh("xdotool", "click", "3")
+    p = wait_for(lambda p: "trace" in p, "the pixel trace")
+    rows = {r["texture"]: r for r in p["trace"]["rows"] if r["tile"] < 0}
+    check(len(rows) >= 15 and "gbuffer.albedo" in rows and "voxelize.radiance" in rows,
+          "the trace lists every pass's textures (%d rows)" % len(p["trace"]["rows"]))
+    out = rows.get("composite.color")
+    want = [int((x - ix + 0.5) / iw * iw), int((1 - (y - iy + 0.5) / ih) * ih)]
+    check(out is not None and out["texel"][:2] == want, "the output's texel is the clicked pixel: %s, want %s"
+          % (out and out["texel"], want))
+    check(out is not None and all(abs(out["value"][c] * 255 - on_screen[c]) <= 3 for c in range(3)),
+          "the output's traced value is what the screen shows there: %s vs %s"
+          % (out and [round(v * 255) for v in out["value"][:3]], on_screen))
+    check("world" in p["trace"] and abs(p["trace"]["world"][1] + 1) < 0.05,
+          "the clicked floor pixel's world position is on the floor (y = -1): %s" % p["trace"].get("world"))
+    screenshot("trace.png")
+
 finally:
     kiln.terminate()
     try:
