@@ -28,13 +28,11 @@ void CompareView::measure(const App& app) {
     problem_.clear();
 }
 
-void CompareView::panel(App& app, double now, glm::vec2 at, const std::function<void(const std::string&)>& probe) {
-    ImGui::SetNextWindowPos(ImVec2(at.x, at.y), ImGuiCond_FirstUseEver);
-    ImGui::SetNextWindowSize(ImVec2(360, 190), ImGuiCond_FirstUseEver);
-    if (!ImGui::Begin("Compare", &on)) {
-        ImGui::End();
-        return;
-    }
+void CompareView::update(const App& app, double now) {
+    if (now - lastMeasure_ >= 1.0) measure(app), lastMeasure_ = now;
+}
+
+void CompareView::panel(App& app, const std::function<void(const std::string&)>& probe) {
     auto pick = [&](const char* label, std::string& name) {
         if (ImGui::BeginCombo(label, name.c_str())) {
             for (auto& t : app.runtime().textures()) {
@@ -50,7 +48,6 @@ void CompareView::panel(App& app, double now, glm::vec2 at, const std::function<
     ImGui::SliderFloat("split", &split, 0.0f, 1.0f, "%.2f");
     ImGui::Checkbox("tonemap both", &tonemap);
     probe("compare-tonemap");
-    if (now - lastMeasure_ >= 1.0) measure(app), lastMeasure_ = now;
     if (errors_) {
         ImGui::Text("A against B, %d pixels%s", errors_->pixels,
                     samples_ > 0 ? (", B at " + std::to_string(samples_) + " paths").c_str() : "");
@@ -63,7 +60,6 @@ void CompareView::panel(App& app, double now, glm::vec2 at, const std::function<
         ImGui::PopTextWrapPos();
     }
     ImGui::TextDisabled("drag the line in the image to move it");
-    ImGui::End();
 }
 
 void CompareView::draw(const TextureViewer& viewer, const App& app, glm::ivec4 rect) const {

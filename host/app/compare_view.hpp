@@ -24,8 +24,12 @@ public:
     bool tonemap = true;             // both through ACES + gamma, as composite shows radiance
     bool dragging = false;
 
-    // The "Compare" ImGui window (first shown at `at`); `probe` records a widget for --ui-probe.
-    void panel(App&, double now, glm::vec2 at, const std::function<void(const std::string&)>& probe);
+    // Measures A against B, at most once a second (while the view is on, whether or not
+    // its panel is shown).
+    void update(const App&, double now);
+    // The sidebar's "Compare" tab: what to compare, the figures; `probe` records a widget
+    // for --ui-probe.
+    void panel(App&, const std::function<void(const std::string&)>& probe);
     // A in the whole image rectangle (GL pixels, origin bottom-left), B right of the line.
     void draw(const TextureViewer&, const App&, glm::ivec4 rect) const;
     const std::optional<metrics::Errors>& errors() const { return errors_; }

@@ -135,10 +135,10 @@ void listPipelines(WindowState& state) {
     std::sort(state.pipelines.begin(), state.pipelines.end());
 }
 
-void pipelineSwitcher(WindowState& state) {
+void pipelineSwitcher(WindowState& state, float width) {
     App& app = *state.app;
     const std::string current = fs::path(app.runtime().pipelineFile()).filename().string();
-    ImGui::SetNextItemWidth(-60);
+    ImGui::SetNextItemWidth(width);
     if (ImGui::BeginCombo("##pipeline", current.c_str())) {
         if (ImGui::IsWindowAppearing()) listPipelines(state);
         for (const std::string& p : state.pipelines) {
@@ -161,16 +161,37 @@ void pipelineSwitcher(WindowState& state) {
     state.probe.item("pipeline-switcher");
 }
 
-void panelPasses(WindowState& state) {
-    App& app = *state.app;
-    PipelineEditor& editor = state.editor;
-    pipelineSwitcher(state);
+// The pipeline switcher and the graph and compare toggles on one line, the switcher taking
+// what the buttons leave (it was given a fixed share, and cut the last button off).
+void headerRow(WindowState& state) {
+    const ImGuiStyle& style = ImGui::GetStyle();
+    auto buttonWidth = [&](const char* label) { return ImGui::CalcTextSize(label).x + style.FramePadding.x * 2; };
+    const float buttons = buttonWidth("graph") + buttonWidth("compare") + style.ItemSpacing.x * 2;
+    pipelineSwitcher(state, std::max(80.0f, ImGui::GetContentRegionAvail().x - buttons));
     ImGui::SameLine();
     if (ImGui::SmallButton("graph")) state.showGraph = !state.showGraph;
     state.probe.item("show-graph");
     ImGui::SameLine();
     if (ImGui::SmallButton("compare")) state.compare.on = !state.compare.on;
     state.probe.item("show-compare");
+}
+
+// What the frame costs and at what size: at the top, where a 720-px window shows it.
+void frameLine(WindowState& state) {
+    App& app = *state.app;
+    ImGui::Text("%.1f ms a frame (%.1f fps), rendering %dx%d", state.frameMs, state.frameMs > 0 ? 1000.0 / state.frameMs : 0.0,
+                app.runtime().outputTexture() ? app.runtime().outputTexture()->width : 0,
+                app.runtime().outputTexture() ? app.runtime().outputTexture()->height : 0);
+    state.probe.item("frame-line");
+    if (state.renderScale < 1.0f) {
+        ImGui::SameLine();
+        ImGui::TextColored(ImVec4(1.0f, 0.75f, 0.3f, 1.0f), "(scale %.2f)", state.renderScale);
+    }
+}
+
+void panelPasses(WindowState& state) {
+    App& app = *state.app;
+    PipelineEditor& editor = state.editor;
     if (ImGui::BeginTable("passes", 4, ImGuiTableFlags_RowBg | ImGuiTableFlags_BordersInnerV | ImGuiTableFlags_SizingFixedFit)) {
         ImGui::TableSetupColumn("pass", ImGuiTableColumnFlags_WidthStretch);
         ImGui::TableSetupColumn("state");
@@ -225,6 +246,11 @@ void panelTextures(WindowState& state) {
     ImGuiTextFilter& filter = state.textureFilter;
     filter.Draw("filter", 160);
     state.probe.item("texture-filter");
+    if (!app.viewed.empty()) {
+        ImGui::SameLine();
+        if (ImGui::SmallButton("clear")) app.viewed.clear();
+    }
+    ImGui::BeginChild("texture list");
     for (auto& t : app.runtime().textures()) {
         const std::string name = t.pass + "." + t.name;
         if (!filter.PassFilter(name.c_str())) continue;
@@ -236,7 +262,7 @@ void panelTextures(WindowState& state) {
         if (ImGui::Selectable(label.c_str(), app.viewed == name)) app.viewed = name, state.showTexture = true;
         state.probe.item("texture:" + name);
     }
-    if (!app.viewed.empty() && ImGui::SmallButton("clear selection")) app.viewed.clear();
+    ImGui::EndChild();
 }
 
 void panelScene(WindowState& state) {
@@ -262,8 +288,6 @@ void panelScene(WindowState& state) {
     else if (!app.paused)
         ImGui::TextDisabled("real time: stepping %.2f ms this frame", app.lastStepMs);
     ImGui::Separator();
-    ImGui::Text("%.1f ms per frame (%.1f fps), rendering %dx%d", state.frameMs, state.frameMs > 0 ? 1000.0 / state.frameMs : 0.0,
-                int(state.image.z * state.renderScale), int(state.image.w * state.renderScale));
     ImGui::Checkbox("resolution follows the budget", &state.autoScale);
     if (ImGui::IsItemHovered()) ImGui::SetTooltip("lowers the render resolution while frames take longer than the budget");
     ImGui::SetNextItemWidth(120);
@@ -329,7 +353,8 @@ void panelGraph(WindowState& state, bool* open) {
     const ImVec2 size(std::min(900.0f, io.DisplaySize.x - 16), std::min(260.0f, io.DisplaySize.y * 0.5f));
     ImGui::SetNextWindowPos(ImVec2(8, io.DisplaySize.y - size.y - 8), ImGuiCond_FirstUseEver);
     ImGui::SetNextWindowSize(size, ImGuiCond_FirstUseEver);
-    if (!ImGui::Begin("Graph", open, ImGuiWindowFlags_HorizontalScrollbar) || !plan) {
+    placeInspector(state, kGraphWindow);
+    if (!ImGui::Begin(kGraphWindow, open, ImGuiWindowFlags_HorizontalScrollbar) || !plan) {
         ImGui::End();
         return;
     }
@@ -382,30 +407,56 @@ void panelErrors(const App& app, WindowState& state) {
     ImGui::End();
 }
 
+namespace {
+
+// One tab at a time in all the height the passes leave: a 720-px window shows ~17 rows
+// of any of them, and a tab scrolls rather than cuts its widgets off.
+void sidebarTabs(WindowState& state) {
+    App& app = *state.app;
+    // Selecting a pass brings its parameters forward; turning the compare view on, its figures.
+    if (state.editor.selected != state.lastSelectedPass && !state.editor.selected.empty()) state.wantTab = "Parameters";
+    if (state.compare.on && !state.lastCompareOn) state.wantTab = "Compare";
+    state.lastSelectedPass = state.editor.selected, state.lastCompareOn = state.compare.on;
+    if (!ImGui::BeginTabBar("panels")) return;
+    auto tab = [&](const char* name, bool* open, const std::function<void()>& contents) {
+        const ImGuiTabItemFlags flags = state.wantTab == name ? ImGuiTabItemFlags_SetSelected : 0;
+        const bool shown = ImGui::BeginTabItem(name, open, flags);
+        state.probe.item(std::string("tab:") + name);
+        if (!shown) return;
+        ImGui::BeginChild(name);
+        contents();
+        ImGui::EndChild();
+        ImGui::EndTabItem();
+    };
+    tab("Parameters", nullptr, [&] { panelParams(state); });
+    tab("Textures", nullptr, [&] { panelTextures(state); });
+    tab("Scene", nullptr, [&] { panelScene(state); });
+    if (state.compare.on)
+        tab("Compare", &state.compare.on, [&] { state.compare.panel(app, [&](const std::string& id) { state.probe.item(id); }); });
+    ImGui::EndTabBar();
+    state.wantTab.clear();
+}
+
+}  // namespace
+
 void drawSidebar(WindowState& state) {
     App& app = *state.app;
     const ImGuiIO& io = ImGui::GetIO();
-    const float h = io.DisplaySize.y;
-    auto place = [&](float y, float height) {
-        ImGui::SetNextWindowPos(ImVec2(0, y), ImGuiCond_FirstUseEver);
-        ImGui::SetNextWindowSize(ImVec2(float(kSidebarWidth), height), ImGuiCond_FirstUseEver);
-    };
-    place(0, h * 0.36f);
-    if (ImGui::Begin("Passes (F1 hides the panels)")) panelPasses(state);
+    // Pinned to the left edge, the whole height (a floating window over it goes behind it
+    // when the sidebar is clicked, as any window does).
+    ImGui::SetNextWindowPos(ImVec2(0, 0), ImGuiCond_Always);
+    ImGui::SetNextWindowSize(ImVec2(float(state.sidebarWidth), io.DisplaySize.y), ImGuiCond_Always);
+    const ImGuiWindowFlags pinned =
+        ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoSavedSettings;
+    if (ImGui::Begin("Kiln (F1 hides the panels)", nullptr, pinned)) {
+        headerRow(state);
+        frameLine(state);
+        panelPasses(state);
+        sidebarTabs(state);
+    }
     ImGui::End();
-    place(h * 0.36f, h * 0.24f);
-    if (ImGui::Begin("Parameters")) panelParams(state);
-    ImGui::End();
-    place(h * 0.6f, h * 0.22f);
-    if (ImGui::Begin("Textures")) panelTextures(state);
-    ImGui::End();
-    place(h * 0.82f, h * 0.18f);
-    if (ImGui::Begin("Scene")) panelScene(state);
-    ImGui::End();
-    if (state.showGraph) panelGraph(state, &state.showGraph);
-    panelTrace(state);
     if (state.compare.on) {
-        state.compare.panel(app, ImGui::GetTime(), {state.image.x + 8, state.image.y + 8}, [&](const std::string& id) { state.probe.item(id); });
+        state.compare.update(app, ImGui::GetTime());
         // The line, over the image; drag it (handleMouse).
         const float x = float(state.image.x) + state.compare.split * float(state.image.z);
         ImDrawList* fg = ImGui::GetForegroundDrawList();
@@ -416,7 +467,11 @@ void drawSidebar(WindowState& state) {
     }
     if (state.showTexture)
         if (const auto t = app.runtime().namedTexture(app.viewed)) {
-            state.viewer.window(*t, &state.showTexture);
+            // Floating (no room in a column, or dragged out): first shown at the top right.
+            ImGui::SetNextWindowPos(ImVec2(io.DisplaySize.x - 8, 8), ImGuiCond_FirstUseEver, ImVec2(1, 0));
+            ImGui::SetNextWindowSize(ImVec2(440, std::min(560.0f, io.DisplaySize.y - 16)), ImGuiCond_FirstUseEver);
+            placeInspector(state, kTextureWindow);
+            state.viewer.window(*t, kTextureWindow, &state.showTexture);
             const glm::vec4 c = state.viewer.canvasRect();
             if (state.probe.on()) state.probe.widgets["texture-canvas"] = {c.x, c.y, c.z, c.w};
             if (const glm::vec4 h = state.viewer.histogramRect(); state.probe.on() && h.z > h.x)
@@ -424,6 +479,8 @@ void drawSidebar(WindowState& state) {
             if (const glm::vec4 b = state.viewer.saveButtonRect(); state.probe.on() && b.z > b.x)
                 state.probe.widgets["texture-save"] = {b.x, b.y, b.z, b.w};
         }
+    panelTrace(state);
+    if (state.showGraph) panelGraph(state, &state.showGraph);
 }
 
 // The pixel trace's window: one row per texture (per tile of a tiled 3D atlas), passes in
@@ -440,7 +497,8 @@ void panelTrace(WindowState& state) {
     fg->AddLine(ImVec2(cx, cy - 8), ImVec2(cx, cy + 8), IM_COL32(255, 80, 200, 255), 1.5f);
     ImGui::SetNextWindowPos(ImVec2(float(state.image.x + state.image.z) - 470, float(state.image.y + state.image.w) - 330), ImGuiCond_FirstUseEver);
     ImGui::SetNextWindowSize(ImVec2(460, 320), ImGuiCond_FirstUseEver);
-    if (ImGui::Begin("Pixel trace (right-click the image)", &state.showTrace)) {
+    placeInspector(state, kTraceWindow);
+    if (ImGui::Begin(kTraceWindow, &state.showTrace)) {
         const TextureRef* out = app.runtime().outputTexture();
         ImGui::Text("pixel (%d, %d) of the output", out ? int(t.uv.x * float(out->width)) : 0, out ? int(t.uv.y * float(out->height)) : 0);
         if (t.world) ImGui::Text("world (%.3f, %.3f, %.3f) from %s", t.world->x, t.world->y, t.world->z, t.depthTexture.c_str());

@@ -3,7 +3,6 @@
 #include <GLFW/glfw3.h>
 
 #include <chrono>
-#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -12,6 +11,7 @@
 #include "app/app.hpp"
 #include "app/cli.hpp"
 #include "app/context.hpp"
+#include "app/stop_signal.hpp"
 #include "kiln/guard.hpp"
 #include "kiln/image_io.hpp"
 #include "kiln/log.hpp"
@@ -47,19 +47,14 @@ bool writeOutputs(App& app, const Options& o, std::string& error) {
     return true;
 }
 
-volatile std::sig_atomic_t stopWatching = 0;
-
 // --watch: frames go on (paced to ~60 a second, so an idle watch costs little) until
 // SIGINT or SIGTERM; the outputs are rewritten after each frame in which an edit landed.
 // A failed edit is reported by the live reloader and leaves the files as they were.
 int watch(App& app, const Options& o) {
-    struct sigaction stop {};
-    stop.sa_handler = [](int) { stopWatching = 1; };
-    sigaction(SIGINT, &stop, nullptr);
-    sigaction(SIGTERM, &stop, nullptr);
+    catchStopSignals();
     log::info("watching for edits; the outputs are rewritten after each one (stop with Ctrl+C)");
     int applied = app.live().applied();
-    while (!stopWatching) {
+    while (!stopSignalled) {
         const auto next = std::chrono::steady_clock::now() + std::chrono::milliseconds(16);
         app.frame();
         if (app.live().applied() != applied) {

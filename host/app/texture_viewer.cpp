@@ -158,14 +158,11 @@ RangeFit TextureViewer::fitRange(const TextureRef& t, float depthNear, float dep
     return fit;
 }
 
-void TextureViewer::window(const run::NamedTexture& nt, bool* open) {
+void TextureViewer::window(const run::NamedTexture& nt, const char* title, bool* open) {
     const TextureRef& t = nt.ref;
     const std::string name = nt.pass + "." + nt.name;
     ViewSettings& s = settings_[name];
-    ImGuiIO& io = ImGui::GetIO();
-    ImGui::SetNextWindowPos(ImVec2(io.DisplaySize.x - 8, 8), ImGuiCond_FirstUseEver, ImVec2(1, 0));
-    ImGui::SetNextWindowSize(ImVec2(440, std::min(560.0f, io.DisplaySize.y - 16)), ImGuiCond_FirstUseEver);
-    if (!ImGui::Begin("Texture", open)) {
+    if (!ImGui::Begin(title, open)) {
         ImGui::End();
         return;
     }
@@ -210,6 +207,18 @@ void TextureViewer::window(const run::NamedTexture& nt, bool* open) {
     ImGui::End();
 }
 
+namespace {
+// The controls wrap in a narrow window (the inspector column) instead of running off it.
+float buttonWidth(const char* label) { return ImGui::CalcTextSize(label).x + ImGui::GetStyle().FramePadding.x * 2; }
+float checkboxWidth(const char* label) {
+    return ImGui::GetFrameHeight() + ImGui::GetStyle().ItemInnerSpacing.x + ImGui::CalcTextSize(label).x;
+}
+void sameLineIfFits(float width) {
+    const float right = ImGui::GetItemRectMax().x + ImGui::GetStyle().ItemSpacing.x + width;
+    if (right <= ImGui::GetWindowPos().x + ImGui::GetWindowContentRegionMax().x) ImGui::SameLine();
+}
+}  // namespace
+
 bool TextureViewer::controls(const run::NamedTexture& nt, ViewSettings& s) {
     const TextureRef& t = nt.ref;
     const bool is3D = t.target == GL_TEXTURE_3D;
@@ -218,26 +227,26 @@ bool TextureViewer::controls(const run::NamedTexture& nt, ViewSettings& s) {
     const char* channels[] = {"RGB", "R", "G", "B", "A"};
     ImGui::SetNextItemWidth(70);
     ImGui::Combo("channel", &s.channel, channels, 5);
-    ImGui::SameLine();
+    sameLineIfFits(buttonWidth("fit range"));
     const bool fitNow = ImGui::Button("fit range");
-    ImGui::SameLine();
+    sameLineIfFits(checkboxWidth("auto"));
     ImGui::Checkbox("auto", &autoFit_);
     if (ImGui::IsItemHovered()) ImGui::SetTooltip("fit the range to what is in view every frame (reads the texture back)");
-    ImGui::SameLine();
+    sameLineIfFits(buttonWidth("1:1"));
     if (ImGui::Button("1:1")) s.zoom = 1.0f;
-    ImGui::SameLine();
+    sameLineIfFits(buttonWidth("fit"));
     if (ImGui::Button("fit")) s.zoom = 0.0f, s.center = glm::vec2(-1.0f);
-    ImGui::SameLine();
+    sameLineIfFits(buttonWidth("save"));
     if (ImGui::Button("save")) save(nt, s);
     const ImVec2 lo = ImGui::GetItemRectMin(), hi = ImGui::GetItemRectMax();
     saveButtonRect_ = {lo.x, lo.y, hi.x, hi.y};
     if (ImGui::IsItemHovered()) ImGui::SetTooltip("write it as PNG (and EXR for float data) into %s", saveDir_.c_str());
     ImGui::DragFloatRange2("range", &s.rangeMin, &s.rangeMax, std::max(1e-4f, (s.rangeMax - s.rangeMin) * 0.005f), 0, 0, "%.5g", "%.5g");
-    if (s.channel != 0) ImGui::Checkbox("false colour", &s.falseColor), ImGui::SameLine();
+    if (s.channel != 0) ImGui::Checkbox("false colour", &s.falseColor), sameLineIfFits(checkboxWidth("alpha checkerboard"));
     ImGui::Checkbox("alpha checkerboard", &s.checker);
-    if (s.channel == 0) ImGui::SameLine(), ImGui::Checkbox("tonemap", &s.tonemap);
+    if (s.channel == 0) sameLineIfFits(checkboxWidth("tonemap")), ImGui::Checkbox("tonemap", &s.tonemap);
     if (isDepthFormat(t.format) && nt.depthNear > 0.0f) {
-        ImGui::SameLine();
+        sameLineIfFits(checkboxWidth("depth in metres"));
         ImGui::Checkbox("depth in metres", &s.linearizeDepth);
         if (ImGui::IsItemHovered()) ImGui::SetTooltip("linearised with the producing camera's planes %.3g .. %.3g", nt.depthNear, nt.depthFar);
     }

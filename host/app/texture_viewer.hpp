@@ -69,7 +69,7 @@ public:
     void draw(const TextureRef& t, float depthNear, float depthFar, const ViewSettings& s, glm::ivec4 rect,
               int legendPx = 0) const;
     // The "Texture" ImGui window for `t`: toolbar, canvas, readout, histogram.
-    void window(const run::NamedTexture& t, bool* open);
+    void window(const run::NamedTexture& t, const char* title, bool* open);
     // Screen rectangle of the canvas in the last window() (x0, y0, x1, y1), for --ui-probe.
     glm::vec4 canvasRect() const { return canvasRect_; }
     glm::vec4 histogramRect() const { return histogramRect_; }  // zero when none is drawn

@@ -4,6 +4,7 @@
 // the script interface (--ui-probe, --screenshot) ui_probe.cpp.
 #include <GLFW/glfw3.h>
 #include <imgui.h>
+#include <imgui_internal.h>  // FindWindowByName, MovingWindow: a docked inspector the user drags out
 #include <backends/imgui_impl_glfw.h>
 #include <backends/imgui_impl_opengl3.h>
 
@@ -15,6 +16,7 @@
 #include <filesystem>
 
 #include "app/context.hpp"
+#include "app/stop_signal.hpp"
 #include "app/window_state.hpp"
 #include "kiln/log.hpp"
 
@@ -53,6 +55,58 @@ void followBudget(WindowState& state, double now) {
 
 namespace {
 
+// The inspector windows open now, in column order.
+std::vector<std::string> openInspectors(const WindowState& state) {
+    std::vector<std::string> open;
+    if (state.showTexture) open.push_back(kTextureWindow);
+    if (state.showTrace && state.traceUv) open.push_back(kTraceWindow);
+    if (state.showGraph) open.push_back(kGraphWindow);
+    return open;
+}
+
+}  // namespace
+
+bool inspectorDocked(const WindowState& state, const std::string& name) {
+    return state.inspector.z > 0 && !state.movedWindows.count(name);
+}
+
+void layOut(WindowState& state, int fbW, int fbH) {
+    state.sidebarWidth = state.showDebug ? std::min(kSidebarWidth, fbW * 2 / 3) : 0;
+    const int area = std::max(1, fbW - state.sidebarWidth);
+    bool docking = false;
+    for (const std::string& name : openInspectors(state)) docking |= !state.movedWindows.count(name);
+    int column = state.showDebug && docking ? std::clamp(fbW * 3 / 10, 300, 460) : 0;
+    if (area - column < std::max(240, area * 2 / 5)) column = 0;  // no room beside the image: they float
+    state.inspector = {fbW - column, 0, column, fbH};
+    const int w = std::max(1, area - column), h = std::max(1, fbH);
+    int iw = w, ih = int(std::lround(w / state.imageAspect));
+    if (ih > h) ih = h, iw = int(std::lround(h * state.imageAspect));
+    iw = std::clamp(iw, 1, w), ih = std::clamp(ih, 1, h);
+    state.image = {state.sidebarWidth + (w - iw) / 2, (h - ih) / 2, iw, ih};
+}
+
+void placeInspector(WindowState& state, const std::string& name) {
+    if (!inspectorDocked(state, name)) return;
+    // Dragged by its title bar this frame: it floats from now on, where the user puts it.
+    if (ImGuiWindow* w = ImGui::FindWindowByName(name.c_str()); w && GImGui->MovingWindow && GImGui->MovingWindow->RootWindow == w) {
+        state.movedWindows.insert(name);
+        return;
+    }
+    std::vector<std::string> docked;
+    for (const std::string& open : openInspectors(state))
+        if (!state.movedWindows.count(open)) docked.push_back(open);
+    const auto at = std::find(docked.begin(), docked.end(), name);
+    if (at == docked.end()) return;
+    const float x = float(state.inspector.x), width = float(state.inspector.z), height = float(state.inspector.w);
+    const size_t index = size_t(at - docked.begin()), n = docked.size();
+    const float first = n == 1 ? height : height * 0.6f, rest = n == 1 ? 0.0f : (height - first) / float(n - 1);
+    const float y = index == 0 ? 0.0f : first + rest * float(index - 1), h = index == 0 ? first : rest;
+    ImGui::SetNextWindowPos(ImVec2(x, y), ImGuiCond_Always);
+    ImGui::SetNextWindowSize(ImVec2(width, h), ImGuiCond_Always);
+}
+
+namespace {
+
 // $XDG_CONFIG_HOME/kiln/imgui.ini (else ~/.config/kiln/imgui.ini); "" when there is
 // no such directory and it cannot be made (then nothing persists).
 std::string imguiIniPath() {
@@ -79,6 +133,7 @@ void startState(WindowState& state, const Options& o, App& app) {
     state.app = &app;
     state.probe.path = o.uiProbe;
     state.mainShowsSelection = !o.view.empty();
+    state.imageAspect = double(o.width) / double(o.height);
     state.showTexture = !o.view.empty();
     state.compare.on = fs::path(o.pipeline).filename() == "compare.json";
     state.autoScale = o.budgetMs > 0;
@@ -129,12 +184,12 @@ int runWindow(const Options& o) {
     using Clock = std::chrono::steady_clock;
     const Clock::time_point start = Clock::now();
     Clock::time_point last = start;
-    for (int frames = 1; !glfwWindowShouldClose(window); ++frames) {
+    catchStopSignals();  // Ctrl+C in the terminal closes the window as Esc does: the layout is saved
+    for (int frames = 1; !glfwWindowShouldClose(window) && !stopSignalled; ++frames) {
         glfwPollEvents();
         int fbW, fbH;
         glfwGetFramebufferSize(window, &fbW, &fbH);
-        const int sidebar = state.showDebug ? std::min(kSidebarWidth, fbW * 2 / 3) : 0;
-        state.image = {sidebar, 0, std::max(1, fbW - sidebar), std::max(1, fbH)};
+        layOut(state, fbW, fbH);
         handleMouse(window, state);
         const Clock::time_point now = Clock::now();
         const double wall = std::chrono::duration<double>(now - last).count();

@@ -12,6 +12,7 @@
 #include <functional>
 #include <map>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -26,6 +27,10 @@ struct GLFWwindow;
 namespace kiln::app {
 
 inline constexpr int kSidebarWidth = 380;  // the panels' column, left of the image
+// The inspector windows' titles (ImGui identifies a window by it), in column order.
+inline constexpr const char* kTextureWindow = "Texture";
+inline constexpr const char* kTraceWindow = "Pixel trace (right-click the image)";
+inline constexpr const char* kGraphWindow = "Graph";
 
 // Where each widget a script may want to click is, and what the texture readout says,
 // written to --ui-probe FILE every frame (tests drive the window with xdotool).
@@ -95,7 +100,18 @@ struct WindowState {
     double pressX = 0, pressY = 0;
     double eventX = 0, eventY = 0;  // the cursor as of the last motion event handled
                                     // (glfwGetCursorPos is the pointer now, later events included)
+    // The layout (window.cpp layOut): the sidebar on the left, the image at the aspect it
+    // was started with, fitted and centred in what is left, and a column on the right for
+    // the inspector windows (texture, trace, graph) while one is open and not moved by the
+    // user, so none covers the image unless the user puts it there.
+    int sidebarWidth = 0;
+    double imageAspect = 1.0;         // width / height, from --size
     glm::ivec4 image{0};              // where the image is, window pixels from the top left
+    glm::ivec4 inspector{0};          // the inspector column (width 0: none, they float)
+    std::set<std::string> movedWindows;  // inspector windows the user dragged out of the column
+    std::string wantTab;              // the sidebar tab to bring forward next frame
+    std::string lastSelectedPass;
+    bool lastCompareOn = false;
     // The pixel trace: a right click on the image picks the pixel (traced every frame
     // while its window is open, so the values follow the scene).
     bool tracePending = false;
@@ -125,6 +141,15 @@ struct WindowState {
     float scaleFloor = kAutoScaleFloor;  // raised where fewer pixels stopped buying time
     std::vector<std::string> pipelines;  // *.json beside the running pipeline
 };
+
+// window.cpp: where the sidebar, the image and the inspector column go for a window
+// of fbW × fbH pixels (sets sidebarWidth, image, inspector).
+void layOut(WindowState&, int fbW, int fbH);
+// Inspector windows in the column, in this order: the first gets 60 % of its height when
+// others share it, the rest split what is left. Each call places `name` (before its Begin)
+// unless the user has dragged it out, or the window has no column: then it floats.
+bool inspectorDocked(const WindowState&, const std::string& name);
+void placeInspector(WindowState&, const std::string& name);
 
 // window.cpp: moves renderScale toward the budget after a frame ending at `now` seconds
 // (frameMs already updated); never below scaleFloor on its own.

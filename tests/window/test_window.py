@@ -148,6 +148,7 @@ try:
 
     # 1. Select a texture: the texture window opens on it; the value under a known
     #    texel is what the headless read-back has there.
+    click("tab:Textures")
     click("texture:gbuffer.albedo")
     p = wait_for(lambda p: p["viewed"] == "gbuffer.albedo" and "texture-canvas" in p["widgets"], "the texture window")
     x0, y0, x1, y1 = p["widgets"]["texture-canvas"]
@@ -293,6 +294,8 @@ try:
     # Input at a slow frame rate (compare.json renders the reference: over a second a
     # frame here): Ctrl+A and a word typed within one frame all arrive, in order. ImGui
     # 1.86 polled key states per frame, so the Ctrl+A was lost and the word appended.
+    check(p["compare"]["on"] and "compare-tonemap" in p["widgets"], "turning the compare view on brings its tab forward")
+    click("tab:Textures")
     click("texture-filter")
     sh("xdotool", "key", "--window", WINDOW, "ctrl+a")
     sh("xdotool", "type", "--window", WINDOW, "--delay", "1", "albedo")
