@@ -439,6 +439,29 @@ void sidebarTabs(WindowState& state) {
 
 }  // namespace
 
+// One split: the compare line and every error pass's "split" parameter are the same value.
+// Whichever moved since the last frame (the line, the Compare tab's slider, or the
+// parameter edited in its tab) sets the other.
+void shareSplit(WindowState& state) {
+    App& app = *state.app;
+    const graph::Plan* plan = app.runtime().plan();
+    if (!plan) return;
+    std::vector<std::string> errorPasses;
+    float parameter = state.sharedSplit;
+    for (const graph::PlannedPass& p : plan->passes)
+        if (p.module == "error")
+            if (const ParamValue* v = p.params.find("split"); v && std::holds_alternative<float>(*v)) {
+                errorPasses.push_back(p.id);
+                if (std::get<float>(*v) != state.sharedSplit) parameter = std::get<float>(*v);
+            }
+    if (state.compare.split != state.sharedSplit) {
+        for (const std::string& id : errorPasses) state.editor.setParam(app, id, "split", state.compare.split);
+    } else if (parameter != state.sharedSplit) {
+        state.compare.split = parameter;
+    }
+    state.sharedSplit = state.compare.split;
+}
+
 void drawSidebar(WindowState& state) {
     App& app = *state.app;
     const ImGuiIO& io = ImGui::GetIO();
@@ -455,6 +478,7 @@ void drawSidebar(WindowState& state) {
         sidebarTabs(state);
     }
     ImGui::End();
+    shareSplit(state);
     if (state.compare.on) {
         state.compare.update(app, ImGui::GetTime());
         // The line, over the image; drag it (handleMouse).
@@ -481,6 +505,32 @@ void drawSidebar(WindowState& state) {
         }
     panelTrace(state);
     if (state.showGraph) panelGraph(state, &state.showGraph);
+}
+
+// The error pass draws its colour map along the image's bottom (passes/error); the window
+// labels its ends and ticks when the image shows that pass's output.
+void legendLabels(WindowState& state) {
+    const App& app = *state.app;
+    const graph::Plan* plan = app.runtime().plan();
+    if (!plan || !plan->output.valid() || state.compare.on || state.mainShowsSelection) return;
+    const graph::PlannedPass& p = plan->passes[size_t(plan->output.pass)];
+    const ParamValue *legend = p.params.find("legend"), *mode = p.params.find("mode"), *scale = p.params.find("scale");
+    if (p.module != "error" || !legend || !std::get<bool>(*legend) || !mode || std::get<std::string>(*mode) == "split") return;
+    std::vector<std::string> labels = {"1e-4", "1e-3", "0.01", "0.1", ">=1"};
+    if (std::get<std::string>(*mode) == "signed") {
+        char v[32];
+        std::snprintf(v, sizeof v, "%.3g", scale ? std::get<float>(*scale) : 1.0f);
+        labels = {std::string("-") + v + " (too dark)", "0", std::string("+") + v + " (too bright)"};
+    }
+    ImDrawList* fg = ImGui::GetForegroundDrawList();
+    const float bottom = float(state.image.y + state.image.w) - 2.0f, height = ImGui::GetTextLineHeight();
+    for (size_t i = 0; i < labels.size(); ++i) {
+        const float t = float(i) / float(labels.size() - 1), w = ImGui::CalcTextSize(labels[i].c_str()).x;
+        const float x = std::clamp(float(state.image.x) + t * float(state.image.z) - w * t, float(state.image.x) + 2.0f,
+                                   float(state.image.x + state.image.z) - w - 2.0f);
+        fg->AddRectFilled(ImVec2(x - 2, bottom - height - 1), ImVec2(x + w + 2, bottom + 1), IM_COL32(0, 0, 0, 170), 2.0f);
+        fg->AddText(ImVec2(x, bottom - height), IM_COL32_WHITE, labels[i].c_str());
+    }
 }
 
 // The pixel trace's window: one row per texture (per tile of a tiled 3D atlas), passes in

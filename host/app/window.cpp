@@ -150,6 +150,7 @@ void drawUi(WindowState& state, int fbW, int fbH) {
     state.uiInput.feed(ImGui::GetIO());
     ImGui::NewFrame();
     if (state.showDebug) drawSidebar(state);
+    legendLabels(state);
     panelErrors(*state.app, state);
     ImGui::Render();
     glBindFramebuffer(GL_FRAMEBUFFER, 0);

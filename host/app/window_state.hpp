@@ -112,6 +112,7 @@ struct WindowState {
     std::string wantTab;              // the sidebar tab to bring forward next frame
     std::string lastSelectedPass;
     bool lastCompareOn = false;
+    float sharedSplit = 0.5f;         // the compare line and error passes' "split" (shareSplit)
     // The pixel trace: a right click on the image picks the pixel (traced every frame
     // while its window is open, so the values follow the scene).
     bool tracePending = false;
@@ -159,6 +160,7 @@ void followBudget(WindowState&, double now);
 void drawSidebar(WindowState&);
 void panelErrors(const App&, WindowState&);
 void panelTrace(WindowState&);
+void legendLabels(WindowState&);
 void drawImage(WindowState&, int framebufferWidth, int framebufferHeight);
 
 // window_input.cpp: keys, wheel and button events, and the left button's drags.

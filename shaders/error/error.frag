@@ -9,6 +9,7 @@ layout(binding = 1) uniform sampler2D u_reference;
 uniform int u_mode;    // 0 relative (false colour), 1 signed, 2 split
 uniform float u_scale;
 uniform float u_split;
+uniform float u_legendPx;  // the legend strip's height in pixels (0: none)
 
 // Black → blue → green → yellow → white over t ∈ [0, 1].
 vec3 falseColour(float t) {
@@ -25,6 +26,16 @@ void main() {
         vec3 shown = v_uv.x < u_split ? image : reference;
         float edge = abs(v_uv.x - u_split) < 0.002 ? 1.0 : 0.0;
         o_color = vec4(mix(displayEncode(shown, kTonemapAces, 2.2), vec3(1.0), edge), 1.0);
+        return;
+    }
+    if (u_mode != 2 && gl_FragCoord.y < u_legendPx) {
+        // The map itself, left to right; dark ticks in the strip's upper half at each
+        // decade (relative) or at 0 (signed).
+        float t = v_uv.x, px = 1.0 / fwidth(v_uv.x);
+        vec3 c = u_mode == 0 ? falseColour(t) : (t > 0.5 ? vec3(1.0, 2.0 - 2.0 * t, 2.0 - 2.0 * t) : vec3(2.0 * t, 2.0 * t, 1.0));
+        float ticks = u_mode == 0 ? 4.0 : 2.0;
+        bool tick = abs(t * ticks - round(t * ticks)) * px / ticks < 1.0 && gl_FragCoord.y > 0.5 * u_legendPx;
+        o_color = vec4(tick ? vec3(0.0) : c, 1.0);
         return;
     }
     vec3 d = image - reference;

@@ -168,10 +168,10 @@ TEST_CASE("reference vs rasterizer: the lamp's direct light on a floor agrees (o
 TEST_CASE("error pass: an image against itself is black, a darker one reads blue in signed mode",
           "[gi][reference]") {
     Rig rig(stillScene(), 16);
-    auto run = [&](const std::string& image, const std::string& mode) {
+    auto run = [&](const std::string& image, const std::string& mode, bool legend = false) {
         rig.load(pipeline("error.color", R"({"id": "reference", "module": "reference", "params": {"samples_per_frame": 4}},
             {"id": "error", "module": "error", "inputs": {"image": ")" + image + R"(", "reference": "reference.radiance"},
-             "params": {"mode": ")" + mode + R"("}})"));
+             "params": {"mode": ")" + mode + R"(", "legend": )" + (legend ? "true" : "false") + "}}"));
         rig.app.frame();
         rig.checkNoErrors();
         return rig.image("error", "color");
@@ -189,4 +189,15 @@ TEST_CASE("error pass: an image against itself is black, a darker one reads blue
             blue += p[2] > 0.99f && p[0] < 0.95f;
         }
     CHECK(blue > darker.width * darker.height / 4);
+    // The legend (16 px: the whole of this image): the map left to right along the bottom
+    // row, black to white (relative), blue to red (signed).
+    const FloatImage relative = run("reference.radiance", "relative", true), signedMap = run("reference.direct", "signed", true);
+    const float* left = relative.at(0, 0);
+    const float* right = relative.at(relative.width - 1, 0);
+    CHECK(left[0] + left[1] + left[2] < 0.1f);
+    CHECK(right[0] + right[1] + right[2] > 2.7f);
+    CHECK(signedMap.at(0, 0)[2] > 0.9f);
+    CHECK(signedMap.at(0, 0)[0] < 0.2f);
+    CHECK(signedMap.at(signedMap.width - 1, 0)[0] > 0.9f);
+    CHECK(signedMap.at(signedMap.width - 1, 0)[2] < 0.2f);
 }

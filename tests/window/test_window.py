@@ -316,6 +316,9 @@ try:
     p = probe()
     check(abs(p["compare"]["split"] - 0.25) < 0.03,
           "dragging the compare line to a quarter leaves it there after the button is up: %.3f" % p["compare"]["split"])
+    error_split = float(p["passes"]["error"]["params"]["split"])
+    check(abs(error_split - p["compare"]["split"]) < 1e-6,
+          "one split: the error pass's split follows the line (%.3f)" % error_split)
     screenshot("compare.png")
 
     # 10. Back to default.json: the compare view follows the pipeline and goes off (it
