@@ -161,6 +161,8 @@ void pipelineSwitcher(WindowState& state, float width) {
     state.probe.item("pipeline-switcher");
 }
 
+GLuint imageTextureFor(const App& app, const WindowState& state, run::NamedTexture& named);
+
 // The pipeline switcher and the graph and compare toggles on one line, the switcher taking
 // what the buttons leave (it was given a fixed share, and cut the last button off).
 void headerRow(WindowState& state) {
@@ -183,6 +185,15 @@ void frameLine(WindowState& state) {
                 app.runtime().outputTexture() ? app.runtime().outputTexture()->width : 0,
                 app.runtime().outputTexture() ? app.runtime().outputTexture()->height : 0);
     state.probe.item("frame-line");
+    // What the image shows, as its texture holds it: no error overlay, no panels.
+    ImGui::SameLine();
+    if (ImGui::SmallButton("save image")) {
+        run::NamedTexture shown;
+        if (imageTextureFor(app, state, shown)) {
+            state.viewer.save(shown, state.mainShowsSelection ? state.viewer.settingsFor(app.viewed) : ViewSettings{});
+        }
+    }
+    state.probe.item("save-image");
     if (state.renderScale < 1.0f) {
         ImGui::SameLine();
         ImGui::TextColored(ImVec4(1.0f, 0.75f, 0.3f, 1.0f), "(scale %.2f)", state.renderScale);
@@ -591,8 +602,10 @@ GLuint imageTextureFor(const App& app, const WindowState& state, run::NamedTextu
     if (!t) return 0;
     named = {};
     named.ref = *t;
-    if (state.mainShowsSelection)
-        if (const auto n = app.runtime().namedTexture(app.viewed)) named = *n;
+    std::string name = app.viewed;
+    if (const graph::Plan* plan = app.runtime().plan(); !state.mainShowsSelection && plan && plan->output.valid())
+        name = plan->passes[size_t(plan->output.pass)].id + "." + plan->output.name;
+    if (const auto n = app.runtime().namedTexture(name)) named = *n;
     return t->id;
 }
 

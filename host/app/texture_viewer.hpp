@@ -77,6 +77,8 @@ public:
     // Where "save" writes the texture shown (PNG, and OpenEXR with the raw values for
     // float and depth formats): --dump's directory, else ./kiln-saves.
     void setSaveDirectory(std::filesystem::path dir) { saveDir_ = std::move(dir); }
+    // Writes the level (and, for 3D seen along z, the slice) on view; says so in lastSaved().
+    void save(const run::NamedTexture& nt, const ViewSettings& s);
     const std::string& lastSaved() const { return lastSaved_; }  // the file written, or why not
 
     ViewSettings& settingsFor(const std::string& name) { return settings_[name]; }
@@ -93,8 +95,6 @@ private:
     // the canvas texture at `size`, the mouse over it (pan, zoom, the texel under the
     // cursor), the readout and histogram below it.
     bool controls(const run::NamedTexture& nt, ViewSettings& s);
-    // Writes the level (and, for 3D seen along z, the slice) on view; says so in lastSaved_.
-    void save(const run::NamedTexture& nt, const ViewSettings& s);
     void ensureCanvas(glm::ivec2 size);
     void canvasInput(const TextureRef& t, ViewSettings& s, glm::vec2 canvasTopLeft, glm::ivec2 size, bool hovered,
                      bool active);

@@ -42,7 +42,7 @@ class Window:
         self.config = os.path.join(OUT, "config-" + name)
         self.kiln = subprocess.Popen([KILN, "--paused", "--size", size, "--budget", "0", "--view", "gbuffer.normal",
                                       "--ui-probe", self.probe_file],
-                                     env=dict(os.environ, XDG_CONFIG_HOME=self.config),
+                                     env=dict(os.environ, XDG_CONFIG_HOME=self.config), cwd=self.dir,
                                      stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
         self.wait_for(lambda p: p["frame"] >= 3, "the first frames")
         self.id = subprocess.run(["xdotool", "search", "--sync", "--name", "^Kiln$"], check=True,
@@ -108,6 +108,17 @@ def check_size(size, window_w, window_h):
         check(canvas is not None and not overlaps(canvas, image),
               "%s: the texture window is beside the image, not over it: %s vs %s" % (name, canvas, image))
         w.screenshot("texture.png")
+
+        # "save image": the image's texture as it holds it, at the render size.
+        x0, y0, x1, y1 = widgets["save-image"]
+        w.xdotool("mousemove", "--window", w.id, str(int((x0 + x1) / 2)), str(int((y0 + y1) / 2)))
+        time.sleep(0.2)
+        w.xdotool("click", "1")
+        p = w.wait_for(lambda p: ".png" in p.get("saved", ""), "the saved image")
+        saved = os.path.join(w.dir, p["saved"].split(" ")[0])  # relative to kiln's working directory
+        size = subprocess.run(["identify", "-format", "%wx%h", saved], capture_output=True, text=True).stdout
+        check(os.path.basename(saved) == "gbuffer.normal.png" and size == "%dx%d" % (p["image"][2], p["image"][3]),
+              "%s: save image wrote what the image shows at its size: %s %s" % (name, saved, size))
 
         # A right click on the image: the trace window joins the column, below the texture window.
         w.xdotool("mousemove", "--window", w.id, str(ix + iw // 2), str(iy + ih * 3 // 4))
