@@ -507,8 +507,9 @@ void drawSidebar(WindowState& state) {
             ImGui::SetNextWindowSize(ImVec2(440, std::min(560.0f, io.DisplaySize.y - 16)), ImGuiCond_FirstUseEver);
             placeInspector(state, kTextureWindow);
             state.viewer.window(*t, kTextureWindow, &state.showTexture);
-            const glm::vec4 c = state.viewer.canvasRect();
+            const glm::vec4 c = state.viewer.canvasRect(), r = state.viewer.windowRect();
             if (state.probe.on()) state.probe.widgets["texture-canvas"] = {c.x, c.y, c.z, c.w};
+            if (state.probe.on()) state.probe.widgets["texture-window"] = {r.x, r.y, r.z, r.w};
             if (const glm::vec4 h = state.viewer.histogramRect(); state.probe.on() && h.z > h.x)
                 state.probe.widgets["texture-histogram"] = {h.x, h.y, h.z, h.w};
             if (const glm::vec4 b = state.viewer.saveButtonRect(); state.probe.on() && b.z > b.x)

@@ -162,7 +162,10 @@ void TextureViewer::window(const run::NamedTexture& nt, const char* title, bool*
     const TextureRef& t = nt.ref;
     const std::string name = nt.pass + "." + nt.name;
     ViewSettings& s = settings_[name];
-    if (!ImGui::Begin(title, open)) {
+    const bool shown = ImGui::Begin(title, open);
+    const ImVec2 at = ImGui::GetWindowPos(), extent = ImGui::GetWindowSize();
+    windowRect_ = {at.x, at.y, at.x + extent.x, at.y + extent.y};
+    if (!shown) {
         ImGui::End();
         return;
     }

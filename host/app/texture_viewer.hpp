@@ -74,6 +74,7 @@ public:
     glm::vec4 canvasRect() const { return canvasRect_; }
     glm::vec4 histogramRect() const { return histogramRect_; }  // zero when none is drawn
     glm::vec4 saveButtonRect() const { return saveButtonRect_; }
+    glm::vec4 windowRect() const { return windowRect_; }
     // Where "save" writes the texture shown (PNG, and OpenEXR with the raw values for
     // float and depth formats): --dump's directory, else ./kiln-saves.
     void setSaveDirectory(std::filesystem::path dir) { saveDir_ = std::move(dir); }
@@ -109,7 +110,7 @@ private:
     std::optional<RangeFit> fit_;
     std::string fitFor_;           // which texture fit_ describes
     bool autoFit_ = false;
-    glm::vec4 canvasRect_{0.0f}, histogramRect_{0.0f}, saveButtonRect_{0.0f};
+    glm::vec4 canvasRect_{0.0f}, histogramRect_{0.0f}, saveButtonRect_{0.0f}, windowRect_{0.0f};
     std::filesystem::path saveDir_ = "kiln-saves";
     std::string lastSaved_;
 };

@@ -14,6 +14,7 @@
 #include <cstdlib>
 #include <cstdio>
 #include <filesystem>
+#include <string_view>
 
 #include "app/context.hpp"
 #include "app/stop_signal.hpp"
@@ -90,6 +91,7 @@ void placeInspector(WindowState& state, const std::string& name) {
     // Dragged by its title bar this frame: it floats from now on, where the user puts it.
     if (ImGuiWindow* w = ImGui::FindWindowByName(name.c_str()); w && GImGui->MovingWindow && GImGui->MovingWindow->RootWindow == w) {
         state.movedWindows.insert(name);
+        ImGui::MarkIniSettingsDirty();
         return;
     }
     std::vector<std::string> docked;
@@ -118,11 +120,34 @@ std::string imguiIniPath() {
     return (dir / "imgui.ini").string();
 }
 
+// Which inspector windows the user dragged out of the column, kept in the ini file beside
+// ImGui's own window places (a "[Kiln][Floating]" entry, one title a line), so a window
+// put somewhere stays there in the next run.
+void keepFloatingWindows(WindowState& state) {
+    ImGuiSettingsHandler handler;
+    handler.TypeName = "Kiln";
+    handler.TypeHash = ImHashStr("Kiln");
+    handler.UserData = &state;
+    handler.ReadOpenFn = [](ImGuiContext*, ImGuiSettingsHandler*, const char* name) -> void* {
+        return std::string_view(name) == "Floating" ? reinterpret_cast<void*>(1) : nullptr;
+    };
+    handler.ReadLineFn = [](ImGuiContext*, ImGuiSettingsHandler* h, void*, const char* line) {
+        if (*line) static_cast<WindowState*>(h->UserData)->movedWindows.insert(line);
+    };
+    handler.WriteAllFn = [](ImGuiContext*, ImGuiSettingsHandler* h, ImGuiTextBuffer* out) {
+        out->append("[Kiln][Floating]\n");
+        for (const std::string& name : static_cast<WindowState*>(h->UserData)->movedWindows) out->appendf("%s\n", name.c_str());
+        out->append("\n");
+    };
+    ImGui::GetCurrentContext()->SettingsHandlers.push_back(handler);
+}
+
 // Panel positions and sizes persist between runs in `ini` ("" : nowhere).
-void startImGui(GLFWwindow* window, const std::string& ini) {
+void startImGui(GLFWwindow* window, const std::string& ini, WindowState& state) {
     IMGUI_CHECKVERSION();
     ImGui::CreateContext();
     ImGui::GetIO().IniFilename = ini.empty() ? nullptr : ini.c_str();
+    keepFloatingWindows(state);  // before the first frame, which reads the file
     // No backend callbacks: ours queue GLFW's events and UiInput feeds them (window_state.hpp).
     ImGui_ImplGlfw_InitForOpenGL(window, false);
     ImGui_ImplOpenGL3_Init("#version 450 core");
@@ -180,7 +205,7 @@ int runWindow(const Options& o) {
     glfwSetWindowUserPointer(window, &state);
     installCallbacks(window);  // ours first: ImGui's GLFW backend chains to the callbacks it finds
     const std::string ini = imguiIniPath();  // outlives ImGui, which keeps a pointer to it
-    startImGui(window, ini);
+    startImGui(window, ini, state);
 
     using Clock = std::chrono::steady_clock;
     const Clock::time_point start = Clock::now();

@@ -89,10 +89,15 @@ TEST_CASE("installed to a prefix, an out-of-tree pass builds against it and relo
     REQUIRE(build.exitCode == 0);
     REQUIRE(fs::exists(exampleBuild / "modules/libpass_vignette.so"));
 
-    // 4. The default image, then the same frame through the example's pipeline, by a kiln
-    // that keeps running (--watch) with the example's shaders and modules searched first.
+    // 4. The example pipeline's image before the vignette (--view composite.color), then
+    // its output, by a kiln that keeps running (--watch) with the example's shaders and
+    // modules searched first.
     const std::string common = " --headless --size " + std::to_string(kSize) + "x" + std::to_string(kSize) + " --paused";
-    auto plain = runProgram(kiln, common + " --out " + quoted(base / "default.png"), 300, (base / "work").string());
+    const std::string exampleFiles = " --pipeline " + quoted(example / "pipelines/vignette.json") + " --shaders " +
+                                      quoted((example / "shaders").string() + ":") + " --modules " +
+                                      quoted((exampleBuild / "modules").string() + ":");
+    auto plain = runProgram(kiln, common + exampleFiles + " --view composite.color --out " + quoted(base / "default.png"),
+                            300, (base / "work").string());
     INFO(plain.err);
     REQUIRE(plain.exitCode == 0);
     kiln::FloatImage original, image;

@@ -34,12 +34,14 @@ def overlaps(a, b):
 
 
 class Window:
-    def __init__(self, size, name):
+    def __init__(self, size, name, fresh=True):
         self.dir = os.path.join(OUT, name)
         shutil.rmtree(self.dir, ignore_errors=True)
         os.makedirs(self.dir)
         self.probe_file = os.path.join(self.dir, "probe.json")
         self.config = os.path.join(OUT, "config-" + name)
+        if fresh:  # the first-run layout, whatever an earlier run left
+            shutil.rmtree(self.config, ignore_errors=True)
         self.kiln = subprocess.Popen([KILN, "--paused", "--size", size, "--budget", "0", "--view", "gbuffer.normal",
                                       "--ui-probe", self.probe_file],
                                      env=dict(os.environ, XDG_CONFIG_HOME=self.config), cwd=self.dir,
@@ -143,11 +145,34 @@ def check_size(size, window_w, window_h):
         check(all(abs(a - b) <= 1 for a, b in zip(p["image"], want)),
               "%s: F1 fits the image to the whole window: %s, want %s" % (name, p["image"], want))
         w.screenshot("f1.png")
+        w.xdotool("key", "--window", w.id, "F1")
+        p = w.wait_for(lambda p: p["image"][0] >= SIDEBAR, "the panels back")
+
+        # Drag the texture window out of the column by its title bar: it floats where it is
+        # put, over the image if the user wants it there, and stays there in the next run.
+        x0, y0, x1, y1 = p["widgets"]["texture-window"]
+        w.xdotool("mousemove", "--window", w.id, str(int(x0 + 60)), str(int(y0 + 8)), "mousedown", "1")
+        for step in range(1, 6):
+            w.xdotool("mousemove", "--window", w.id, str(int(x0 + 60 - step * 60)), str(int(y0 + 8 + step * 20)))
+            w.frames_later(1)
+        w.xdotool("mouseup", "1")
+        p = w.frames_later()
+        moved = p["widgets"]["texture-window"]
+        check(abs(moved[0] - (x0 - 300)) <= 3 and abs(moved[1] - (y0 + 100)) <= 3,
+              "%s: the texture window follows a drag out of the column: %s -> %s" % (name, [x0, y0], moved[:2]))
     finally:
         w.close()
     ini = os.path.join(w.config, "kiln", "imgui.ini")
-    check(os.path.exists(ini) and "[Window][Texture]" in open(ini).read(),
-          "%s: window places are kept in %s" % (name, ini))
+    check(os.path.exists(ini) and "[Window][Texture]" in open(ini).read() and "[Kiln][Floating]\nTexture" in open(ini).read(),
+          "%s: window places, and that the texture window floats, are kept in %s" % (name, ini))
+    again = Window(size, name, fresh=False)
+    try:
+        p = again.frames_later()
+        kept = p["widgets"].get("texture-window")
+        check(kept is not None and all(abs(a - b) <= 2 for a, b in zip(kept, moved)),
+              "%s: the next run opens the texture window where it was left: %s (left at %s)" % (name, kept, moved))
+    finally:
+        again.close()
 
 
 try:
