@@ -184,7 +184,10 @@ try:
     # 2. An integer texture (R32UI voxel counts) is not black: the fitted range is > 0.
     click("texture-filter")
     sh("xdotool", "type", "--window", WINDOW, "count")
-    wait_for(lambda p: "texture:voxelize.count" in p["widgets"], "voxelize.count in the filtered list")
+    # The whole word first: the characters reach ImGui one a frame, and the rows move as
+    # the filter narrows (a click aimed after "c" landed on another row after "count").
+    wait_for(lambda p: p["texture_filter"] == "count" and "texture:voxelize.count" in p["widgets"],
+             "voxelize.count in the list filtered by \"count\"")
     click("texture:voxelize.count")
     p = wait_for(lambda p: p["viewed"] == "voxelize.count" and "fit" in p, "a fit of voxelize.count")
     check(p["fit"][1] >= 1, "voxelize.count (R32UI) fits to a range with counts: %s" % p["fit"])
