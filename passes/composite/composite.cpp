@@ -36,6 +36,9 @@ public:
             .param(floatParam("gamma", 2.2f, 1.0, 3.0))
             .param(intChoiceParam("pcf", 5, {1, 3, 5, 7, 9},
                                   "shadow filter about k+1 texels wide from ((k+1)/2)² bilinear depth comparisons; 1 = one"))
+            .param(enumParam("shadow_filter", "pcf", {"pcf", "pcss"},
+                             "pcf: the fixed filter of `pcf`; pcss: a penumbra sized by the lamp and the blockers' "
+                             "distance (25 depth reads + 16 bilinear comparisons a pixel)"))
             .param(floatParam("indirect_strength", 1.0f, 0.0, 8.0, "scales the bound indirect irradiance (1 = physical)"))
             .param(floatParam("shadow_bias", 0.0005f, 0.0, 0.05, "depth bias of the shadow test"))
             .param(enumParam("lamp_model", "contour", {"contour", "points", "traced"},
@@ -60,7 +63,8 @@ public:
                                             {"KILN_LAMP_CONTOUR", lampModel == "points" ? "0" : "1"},
                                             {"KILN_LAMP_TRACED", lampModel == "traced" ? "1" : "0"},
                                             {"KILN_LAMP_NEAR_FIELD", nearField ? "1" : "0"},
-                                            {"KILN_PCF", std::to_string(ctx.getInt("pcf"))}}});
+                                            {"KILN_PCF", std::to_string(ctx.getInt("pcf"))},
+                                            {"KILN_PCSS", ctx.getEnum("shadow_filter") == "pcss" ? "1" : "0"}}});
         };
         GLuint program = variant(false);
         if (!program) return;
@@ -107,6 +111,7 @@ private:
                                      {"indirect", "u_indirect"}, {"bloom", "u_bloom"}})
             kiln::gl::bindTexture(program, sampler, ctx.input(slot).id);
         kiln::gl::bindSamplerObject(program, "u_shadowMap", compareSampler_.id());
+        kiln::gl::bindTexture(program, "u_shadowDepth", ctx.input("shadow_map").id);  // pcss only
         const std::string& tonemap = ctx.getEnum("tonemap");
         glUniform1f(glGetUniformLocation(program, "u_exposure"), ctx.getFloat("exposure"));
         glUniform1f(glGetUniformLocation(program, "u_ambient"), ctx.getFloat("ambient"));

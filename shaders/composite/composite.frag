@@ -18,6 +18,9 @@ layout(binding = 3) uniform sampler2D u_emissive;
 layout(binding = 4) uniform sampler2DShadow u_shadowMap;  // a comparison sampler is bound with it
 layout(binding = 5) uniform sampler2D u_indirect;
 layout(binding = 6) uniform sampler2D u_bloom;
+#if KILN_PCSS
+layout(binding = 7) uniform sampler2D u_shadowDepth;  // the same map, raw depths (texelFetch: no sampler state)
+#endif
 
 uniform float u_exposure;
 uniform float u_ambient;
@@ -27,10 +30,54 @@ uniform float u_shadowBias;
 uniform float u_indirectStrength;
 uniform float u_lampNearField;  // lamp_model traced: metres from the dome evaluated per pixel
 
+#if KILN_PCSS && KILN_HAS_SHADOW_MAP
+// Metres along the lamp's view axis of a shadow-map depth in [0, 1].
+float lightLinearDepth(float depth) {
+    float z = depth * 2.0 - 1.0;
+    return 2.0 * kLightNear * kLightFar / (kLightFar + kLightNear - z * (kLightFar - kLightNear));
+}
+
+// Soft shadows sized by the lamp (percentage-closer soft shadows, Fernando 2005). The
+// lamp is taken as a disc of radius R = u_lightPos.w at the map's centre of projection.
+// A blocker at depth d_b hides part of it from p (at depth d_r) when it lies within
+// R (d_r − d_b) / (2 tan 70° d_b d_r) of p's point in the map (the map spans 140°): its
+// penumbra's half-width there. 1) The blockers: a 5×5 grid of raw depths over the widest
+// such region (blockers no nearer the lamp than kPcssNearest); none: lit. 2) A 4×4 grid
+// of comparison lookups (each a bilinear blend of four tests) over the penumbra of their
+// mean depth, never narrower than one texel apart.
+const float kPcssNearest = 0.4;
+float shadowSoft(sampler2DShadow shadowMap, sampler2D depths, vec3 p, float bias) {
+    vec4 ls = lightSpace(p);
+    if (ls.w == 0.0) return 1.0;
+    const float perMetre = 0.5 / tan(radians(70.0));
+    float receiver = lightLinearDepth(ls.z), radius = u_lightPos.w;
+    vec2 size = vec2(textureSize(depths, 0));
+    float search = radius * perMetre * max(receiver - kPcssNearest, 0.0) / (kPcssNearest * receiver);
+    float sum = 0.0, blockers = 0.0;
+    for (int y = 0; y < 5; ++y)
+        for (int x = 0; x < 5; ++x) {
+            vec2 uv = ls.xy + (vec2(x, y) - 2.0) * 0.5 * search;
+            float d = texelFetch(depths, ivec2(clamp(uv, vec2(0.0), vec2(1.0)) * (size - 1.0)), 0).r;
+            if (d < ls.z - bias) sum += lightLinearDepth(d), blockers += 1.0;
+        }
+    if (blockers == 0.0) return 1.0;
+    float blocker = sum / blockers;
+    float penumbra = radius * perMetre * max(receiver - blocker, 0.0) / (blocker * receiver);
+    vec2 spacing = max(vec2(penumbra / 1.5), 1.0 / size);
+    float lit = 0.0;
+    for (int y = 0; y < 4; ++y)
+        for (int x = 0; x < 4; ++x) lit += texture(shadowMap, vec3(ls.xy + (vec2(x, y) - 1.5) * spacing, ls.z - bias));
+    return lit / 16.0;
+}
+#endif
+
 // Fraction of the lamp that sees p: a k×k percentage-closer filter over the shadow
-// map (k = KILN_PCF; 1 is one bilinear test). No map bound: everything is lit.
+// map (k = KILN_PCF; 1 is one bilinear test), or one sized by the lamp (KILN_PCSS). No
+// map bound: everything is lit.
 float lightVisibility(vec3 p) {
-#if KILN_HAS_SHADOW_MAP
+#if KILN_HAS_SHADOW_MAP && KILN_PCSS
+    return shadowSoft(u_shadowMap, u_shadowDepth, p, u_shadowBias);
+#elif KILN_HAS_SHADOW_MAP
     return shadowFiltered(u_shadowMap, p, u_shadowBias);
 #else
     return 1.0;

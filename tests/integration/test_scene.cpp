@@ -191,3 +191,37 @@ TEST_CASE("sphere level of detail: the silhouette stays within a pixel of the ci
     CHECK(worst > 0.5);  // and the coarse meshes are really used near their limits
     CHECK(scene::sphereLevelFor(500.0f) == 0);
 }
+
+TEST_CASE("composite shadow_filter pcss: the tumbler's shadow keeps its core and gets a wider edge than one lookup",
+          "[scene][gl]") {
+    Rig rig(oneTumblerScene());
+    // Floor radiance from inside the shadow (x = 0) out into the light (x = 0.6) at z = 0.72.
+    auto profile = [&](const std::string& filter, int pcf) {
+        std::string error;
+        REQUIRE(rig.app.runtime().setParam("composite", "shadow_filter", ParamValue(filter), error));
+        REQUIRE(rig.app.runtime().setParam("composite", "pcf", ParamValue(pcf), error));
+        rig.app.frame();
+        const TextureRef* hdr = rig.app.runtime().findTexture("composite", "hdr");
+        REQUIRE(hdr);
+        const FloatImage img = readTexture(hdr->id, hdr->target, hdr->format, hdr->width, hdr->height);
+        std::vector<float> lum;
+        for (int i = 0; i <= 60; ++i) {
+            const glm::vec2 px = rig.pixelOf({0.01f * float(i), -1.0f, 0.72f}, 160);
+            const float* v = img.at(int(px.x), int(px.y));
+            lum.push_back(v[0] + v[1] + v[2]);
+        }
+        return lum;
+    };
+    // The edge's width: samples (1 cm apart) between 20 % and 80 % of the way from the
+    // darkest to the brightest.
+    auto edgeWidth = [](const std::vector<float>& lum) {
+        const auto [lo, hi] = std::minmax_element(lum.begin(), lum.end());
+        int inside = 0;
+        for (float v : lum) inside += v > *lo + 0.2f * (*hi - *lo) && v < *lo + 0.8f * (*hi - *lo);
+        return inside;
+    };
+    const std::vector<float> hard = profile("pcf", 1), soft = profile("pcss", 1);
+    INFO("edge widths (cm): one lookup " << edgeWidth(hard) << ", pcss " << edgeWidth(soft));
+    CHECK(edgeWidth(soft) > edgeWidth(hard));
+    CHECK(soft.front() * 2.0f < soft.back());  // the core stays dark
+}

@@ -94,8 +94,8 @@ TEST_CASE("installed to a prefix, an out-of-tree pass builds against it and relo
     // modules searched first.
     const std::string common = " --headless --size " + std::to_string(kSize) + "x" + std::to_string(kSize) + " --paused";
     const std::string exampleFiles = " --pipeline " + quoted(example / "pipelines/vignette.json") + " --shaders " +
-                                      quoted((example / "shaders").string() + ":") + " --modules " +
-                                      quoted((exampleBuild / "modules").string() + ":");
+                                      quoted(fs::path((example / "shaders").string() + ":")) + " --modules " +
+                                      quoted(fs::path((exampleBuild / "modules").string() + ":"));
     auto plain = runProgram(kiln, common + exampleFiles + " --view composite.color --out " + quoted(base / "default.png"),
                             300, (base / "work").string());
     INFO(plain.err);
