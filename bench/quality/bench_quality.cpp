@@ -233,13 +233,20 @@ bool referenceHalf(app::App& app, const Args& args, int half, FloatImage& out, F
     key = fnv1a(values, sizeof values, key);
     const uint64_t simState = app.scene().sim().stateHash();
     key = fnv1a(&simState, sizeof simState, key);
-    // An installed Kiln has the module, not its source.
-    const fs::path source(KILN_SOURCE_DIR), data = app::defaultDataRoot();
+    // The reference's code: its module's source (an installed Kiln has the module instead)
+    // and the files its shader reads, includes followed. Only those: an edit to a shared
+    // include the reference does not read (composite's shadows) keeps the cache.
+    const fs::path source(KILN_SOURCE_DIR);
     std::vector<fs::path> code = {fs::exists(source / "passes/reference/reference.cpp")
                                       ? source / "passes/reference/reference.cpp"
                                       : shippedFiles().modules / "libpass_reference.so"};
-    for (const char* dir : {"shaders/reference", "shaders/common"})
-        for (const auto& entry : fs::directory_iterator(data / dir)) code.push_back(entry.path());
+    PreprocessedSource shader;
+    ShaderError shaderError;
+    if (!app.runtime().shaders().preprocess("reference/path.comp", {}, shader, shaderError)) {
+        std::fprintf(stderr, "kiln-bench-quality: error: %s\n", shaderError.toString().c_str());
+        return false;
+    }
+    code.insert(code.end(), shader.dependencies.begin(), shader.dependencies.end());
     std::sort(code.begin(), code.end());
     for (const fs::path& file : code) key = fnv1a(slurp(file.string()), key);
     char name[80];
