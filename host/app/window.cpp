@@ -88,12 +88,6 @@ void layOut(WindowState& state, int fbW, int fbH) {
 
 void placeInspector(WindowState& state, const std::string& name) {
     if (!inspectorDocked(state, name)) return;
-    // Dragged by its title bar this frame: it floats from now on, where the user puts it.
-    if (ImGuiWindow* w = ImGui::FindWindowByName(name.c_str()); w && GImGui->MovingWindow && GImGui->MovingWindow->RootWindow == w) {
-        state.movedWindows.insert(name);
-        ImGui::MarkIniSettingsDirty();
-        return;
-    }
     std::vector<std::string> docked;
     for (const std::string& open : openInspectors(state))
         if (!state.movedWindows.count(open)) docked.push_back(open);
@@ -103,6 +97,15 @@ void placeInspector(WindowState& state, const std::string& name) {
     const size_t index = size_t(at - docked.begin()), n = docked.size();
     const float first = n == 1 ? height : height * 0.6f, rest = n == 1 ? 0.0f : (height - first) / float(n - 1);
     const float y = index == 0 ? 0.0f : first + rest * float(index - 1), h = index == 0 ? first : rest;
+    // Dragged away from its slot (ImGui moved it this frame, before we place it): it floats
+    // from now on, where the user puts it. A click that moves nothing keeps it docked.
+    if (ImGuiWindow* w = ImGui::FindWindowByName(name.c_str());
+        w && GImGui->MovingWindow && GImGui->MovingWindow->RootWindow == w &&
+        std::max(std::abs(w->Pos.x - x), std::abs(w->Pos.y - y)) > 2.0f) {
+        state.movedWindows.insert(name);
+        ImGui::MarkIniSettingsDirty();
+        return;
+    }
     ImGui::SetNextWindowPos(ImVec2(x, y), ImGuiCond_Always);
     ImGui::SetNextWindowSize(ImVec2(width, h), ImGuiCond_Always);
 }

@@ -148,6 +148,16 @@ def check_size(size, window_w, window_h):
         w.xdotool("key", "--window", w.id, "F1")
         p = w.wait_for(lambda p: p["image"][0] >= SIDEBAR, "the panels back")
 
+        # A click held on the docked window's title bar (ImGui starts a move there) that
+        # moves nothing: it stays docked, and the image keeps its place.
+        x0, y0, x1, y1 = p["widgets"]["texture-window"]
+        w.xdotool("mousemove", "--window", w.id, str(int(x0 + 120)), str(int(y0 + 8)), "mousedown", "1")
+        w.frames_later()  # held still over several frames, as a person's click is
+        w.xdotool("mouseup", "1")
+        q = w.frames_later()
+        check(q["widgets"]["texture-window"] == p["widgets"]["texture-window"] and q["image"] == p["image"],
+              "%s: a click inside the docked texture window leaves it docked: %s" % (name, q["widgets"]["texture-window"]))
+
         # Drag the texture window out of the column by its title bar: it floats where it is
         # put, over the image if the user wants it there, and stays there in the next run.
         x0, y0, x1, y1 = p["widgets"]["texture-window"]
