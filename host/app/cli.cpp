@@ -55,7 +55,8 @@ Window keys and mouse:
   drag empty space                  orbit the camera          wheel  zoom
   Space  pause/resume   .  single step   R  reset the scene
   M  spawn a marble     F  spawn a fireball
-  F1  toggle the debug view              Esc  quit
+  F1  toggle the debug view              Esc (or Ctrl+C in the terminal)  quit
+  right-click the image: trace that pixel through every pass's textures
   texture window: wheel zooms about the cursor, drag pans, hover reads the value
   compare view: drag the line across the image
 )";
