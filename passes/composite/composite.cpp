@@ -36,6 +36,10 @@ public:
             .param(floatParam("gamma", 2.2f, 1.0, 3.0))
             .param(intChoiceParam("pcf", 5, {1, 3, 5, 7, 9},
                                   "shadow filter about k+1 texels wide from ((k+1)/2)² bilinear depth comparisons; 1 = one"))
+            .param(enumParam("fireball_light", "voxels", {"voxels", "analytic"},
+                             "voxels: the fireballs light surfaces through the cones (cone_trace.indirect); "
+                             "analytic: here, each a sphere of its radiance, unshadowed (pair with "
+                             "voxelize.fireball_emission 0)"))
             .param(enumParam("shadow_filter", "pcf", {"pcf", "pcss"},
                              "pcf: the fixed filter of `pcf`; pcss: a penumbra sized by the lamp and the blockers' "
                              "distance (25 depth reads + 16 bilinear comparisons a pixel)"))
@@ -51,7 +55,7 @@ public:
                               "pixel (the irradiance changes faster there than the traced samples); 0 compiles that out"))
             .param(intChoiceParam("lamp_samples", 32, {4, 8, 16, 32, 64},
                                   "vertices of the lamp's silhouette (contour) or quadrature points over its cap (points)"));
-        d.reads = kSceneLight | kSceneCamera;
+        d.reads = kSceneLight | kSceneCamera | kSceneFireballs;
         return d;
     }
 
@@ -64,7 +68,8 @@ public:
                                             {"KILN_LAMP_TRACED", lampModel == "traced" ? "1" : "0"},
                                             {"KILN_LAMP_NEAR_FIELD", nearField ? "1" : "0"},
                                             {"KILN_PCF", std::to_string(ctx.getInt("pcf"))},
-                                            {"KILN_PCSS", ctx.getEnum("shadow_filter") == "pcss" ? "1" : "0"}}});
+                                            {"KILN_PCSS", ctx.getEnum("shadow_filter") == "pcss" ? "1" : "0"},
+                                            {"KILN_FIREBALLS_ANALYTIC", ctx.getEnum("fireball_light") == "analytic" ? "1" : "0"}}});
         };
         GLuint program = variant(false);
         if (!program) return;
@@ -120,6 +125,8 @@ private:
         glUniform1f(glGetUniformLocation(program, "u_shadowBias"), ctx.getFloat("shadow_bias"));
         glUniform1f(glGetUniformLocation(program, "u_indirectStrength"), ctx.getFloat("indirect_strength"));
         glUniform1f(glGetUniformLocation(program, "u_lampNearField"), ctx.getFloat("lamp_near_field"));
+        glUniform1i(glGetUniformLocation(program, "u_firstFireball"), int(ctx.scene().firstInstance(kiln::kSceneFireballs)));
+        glUniform1i(glGetUniformLocation(program, "u_fireballCount"), int(ctx.scene().count(kiln::kSceneFireballs)));
         ctx.drawFullscreenTriangle();
     }
 

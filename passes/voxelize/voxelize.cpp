@@ -75,6 +75,10 @@ public:
             .param(enumParam("particle_mode", "splat", {"splat", "mesh"},
                              "splat: a compute pass adds each particle to the voxels it overlaps; mesh: rasterize "
                              "its octahedron like every other mesh"))
+            .param(floatParam("fireball_emission", 1.0f, 0.0, 1.0,
+                              "the fireballs' emission in the voxels (fireball_mode mesh): 1, they light surfaces "
+                              "through the cones; 0 when composite lights surfaces with them directly "
+                              "(composite.fireball_light analytic) and the voxels keep only what they light"))
             .param(enumParam("fireball_mode", "mesh", {"mesh", "splat"},
                              "mesh: rasterize its sphere like every other mesh; splat: a compute pass adds each "
                              "fireball, as one fragment, to the voxels its surface passes through (cheaper with "
@@ -136,12 +140,15 @@ private:
         kiln::gl::bindTexture(raster, "u_shadowMap", ctx.input("shadow_map").id);
         bindSums(ctx, raster, GL_READ_WRITE);
         uint32_t cats = kiln::kSceneBox | kiln::kSceneTumblers;
-        if (rasterFireballs) cats |= kiln::kSceneFireballs;
         if (rasterParticles) cats |= kiln::kSceneParticles;
         if (ctx.getBool("marbles")) cats |= kiln::kSceneMarbles;
         const GLint emissionScale = glGetUniformLocation(raster, "u_emissionScale");
         glUniform1f(emissionScale, 1.0f);
         ctx.drawScene({.categories = cats, .lod = kiln::Lod::Low});
+        if (rasterFireballs) {
+            glUniform1f(emissionScale, ctx.getFloat("fireball_emission"));
+            ctx.drawScene({.categories = kiln::kSceneFireballs, .lod = kiln::Lod::Low});
+        }
         glUniform1f(emissionScale, ctx.getFloat("lamp_emission"));
         ctx.drawScene({.categories = kiln::kSceneLamp, .lod = kiln::Lod::Low});
         glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);

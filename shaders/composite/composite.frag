@@ -71,6 +71,24 @@ float shadowSoft(sampler2DShadow shadowMap, sampler2D depths, vec3 p, float bias
 }
 #endif
 
+#if KILN_FIREBALLS_ANALYTIC
+#include "common/instances.glsl"
+uniform int u_firstFireball, u_fireballCount;
+// The fireballs' irradiance at p: each a sphere of uniform radiance L, E = π L (r/d)² cos θ
+// (exact while the whole sphere is above p's horizon; they are small), unshadowed.
+vec3 fireballIrradiance(vec3 p, vec3 n) {
+    vec3 e = vec3(0.0);
+    for (int i = 0; i < u_fireballCount; ++i) {
+        KilnInstance f = kiln_instances[u_firstFireball + i];
+        vec3 toCentre = kilnSphereCentre(f) - p;
+        float d2 = dot(toCentre, toCentre), r = kilnSphereRadius(f);
+        float cosTheta = dot(n, toCentre) * inversesqrt(max(d2, 1e-8));
+        e += f.emissive.rgb * (3.14159265 * r * r / max(d2, r * r)) * max(cosTheta, 0.0);
+    }
+    return e;
+}
+#endif
+
 // Fraction of the lamp that sees p: a k×k percentage-closer filter over the shadow
 // map (k = KILN_PCF; 1 is one bilinear test), or one sized by the lamp (KILN_PCSS). No
 // map bound: everything is lit.
@@ -117,6 +135,9 @@ void main() {
 #endif
         float visible = max(irradiance.r, max(irradiance.g, irradiance.b)) > 0.0 ? lightVisibility(p + n * 0.004) : 0.0;
         vec3 direct = albedo / 3.14159265 * irradiance * visible;
+#if KILN_FIREBALLS_ANALYTIC
+        direct += albedo / 3.14159265 * fireballIrradiance(p, n);
+#endif
         vec3 indirect = albedo * u_indirectStrength * texture(u_indirect, v_uv).rgb;
 #if KILN_HAS_INDIRECT == 0
         indirect = albedo * u_ambient;
