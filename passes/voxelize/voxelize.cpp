@@ -79,6 +79,9 @@ public:
                               "the fireballs' emission in the voxels (fireball_mode mesh): 1, they light surfaces "
                               "through the cones; 0 when composite lights surfaces with them directly "
                               "(composite.fireball_light analytic) and the voxels keep only what they light"))
+            .param(boolParam("fireball_flux", false,
+                             "scale each fireball's emission by pi r^2 / (2r + h)^2 (h: the voxel side), so its "
+                             "voxelized blob carries the sphere's flux (fireball_mode mesh)"))
             .param(enumParam("fireball_mode", "mesh", {"mesh", "splat"},
                              "mesh: rasterize its sphere like every other mesh; splat: a compute pass adds each "
                              "fireball, as one fragment, to the voxels its surface passes through (cheaper with "
@@ -147,7 +150,9 @@ private:
         ctx.drawScene({.categories = cats, .lod = kiln::Lod::Low});
         if (rasterFireballs) {
             glUniform1f(emissionScale, ctx.getFloat("fireball_emission"));
+            glUniform1i(glGetUniformLocation(raster, "u_sphereFlux"), ctx.getBool("fireball_flux") ? 1 : 0);
             ctx.drawScene({.categories = kiln::kSceneFireballs, .lod = kiln::Lod::Low});
+            glUniform1i(glGetUniformLocation(raster, "u_sphereFlux"), 0);
         }
         glUniform1f(emissionScale, ctx.getFloat("lamp_emission"));
         ctx.drawScene({.categories = kiln::kSceneLamp, .lod = kiln::Lod::Low});
