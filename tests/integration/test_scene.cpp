@@ -267,3 +267,32 @@ TEST_CASE("composite fireball_light analytic: a fireball above the floor adds al
         CHECK(with[c] - without[c] == Approx(expected).epsilon(0.01));
     }
 }
+
+TEST_CASE("voxelize fireball_flux: the voxels take each fireball at pi r^2 / (2r + h)^2 of its radiance",
+          "[scene][gl]") {
+    const fs::path file = fs::path(TEST_OUTPUT_DIR) / "one_fireball_flux.json";
+    std::ofstream(file) << R"({"tumblers": [], "fireballs": [{"position": [0.1, -0.2, 0.3], "velocity": [0, 0, 0],
+                                                              "radius": 0.08, "color": [1.0, 0.5, 0.1]}]})";
+    Rig rig(file.string(), 32);
+    std::string error;
+    auto voxels = [&](bool flux, float emission) {
+        REQUIRE(rig.app.runtime().setParam("voxelize", "fireball_flux", ParamValue(flux), error));
+        REQUIRE(rig.app.runtime().setParam("voxelize", "fireball_emission", ParamValue(emission), error));
+        rig.app.frame();
+        const TextureRef* t = rig.app.runtime().findTexture("voxelize", "radiance");
+        REQUIRE(t);
+        return readTextureBox(t->id, t->format, 0, 0, 0, 0, t->width, t->height, t->depth);
+    };
+    const int res = rig.app.runtime().findTexture("voxelize", "radiance")->width;
+    const double r = 0.08, h = 2.0 / res, scale = M_PI * r * r / ((2 * r + h) * (2 * r + h));
+    const std::vector<float> flux = voxels(true, 1.0f), scaled = voxels(false, float(scale)), full = voxels(false, 1.0f);
+    REQUIRE(flux.size() == scaled.size());
+    double worst = 0, differsFromFull = 0;
+    for (size_t i = 0; i < flux.size(); ++i) {
+        worst = std::max(worst, double(std::abs(flux[i] - scaled[i])));
+        differsFromFull = std::max(differsFromFull, double(std::abs(flux[i] - full[i])));
+    }
+    INFO("scale " << scale << ": largest difference from the scaled run " << worst << ", from the full one " << differsFromFull);
+    CHECK(worst < 1e-3);            // half-float voxels and fixed-point sums: equal but for rounding
+    CHECK(differsFromFull > 0.05);  // and the fireball is there to be scaled
+}
