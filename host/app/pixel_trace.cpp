@@ -14,11 +14,6 @@ glm::vec4 readTexel(const TextureRef& t, glm::ivec3 texel) {
     return v.size() >= 4 ? glm::vec4(v[0], v[1], v[2], v[3]) : glm::vec4(0.0f);
 }
 
-bool isDepthFormat(GLenum format) {
-    return format == GL_DEPTH_COMPONENT16 || format == GL_DEPTH_COMPONENT24 || format == GL_DEPTH_COMPONENT32F ||
-           format == GL_DEPTH_COMPONENT32 || format == GL_DEPTH24_STENCIL8 || format == GL_DEPTH32F_STENCIL8;
-}
-
 glm::ivec2 texelOf(glm::vec2 uv, int width, int height) {
     return {std::clamp(int(std::floor(uv.x * float(width))), 0, width - 1),
             std::clamp(int(std::floor(uv.y * float(height))), 0, height - 1)};
@@ -28,7 +23,7 @@ glm::ivec2 texelOf(glm::vec2 uv, int width, int height) {
 // camera's planes; none when the pixel sees nothing (depth at the far plane).
 void findWorld(const std::vector<run::NamedTexture>& textures, const glm::mat4& invViewProj, PixelTrace& trace) {
     for (const run::NamedTexture& t : textures) {
-        if (t.ref.target != GL_TEXTURE_2D || !isDepthFormat(t.ref.format) || t.depthNear != kCameraNear ||
+        if (t.ref.target != GL_TEXTURE_2D || !gl::isDepthFormat(t.ref.format) || t.depthNear != kCameraNear ||
             t.depthFar != kCameraFar)
             continue;
         trace.depthTexture = t.pass + "." + t.name;
