@@ -65,6 +65,14 @@ std::vector<std::string> openInspectors(const WindowState& state) {
     return open;
 }
 
+// Those of them in the column: the user has not dragged them out.
+std::vector<std::string> dockedInspectors(const WindowState& state) {
+    std::vector<std::string> docked;
+    for (const std::string& name : openInspectors(state))
+        if (!state.movedWindows.count(name)) docked.push_back(name);
+    return docked;
+}
+
 }  // namespace
 
 bool inspectorDocked(const WindowState& state, const std::string& name) {
@@ -74,9 +82,7 @@ bool inspectorDocked(const WindowState& state, const std::string& name) {
 void layOut(WindowState& state, int fbW, int fbH) {
     state.sidebarWidth = state.showDebug ? std::min(kSidebarWidth, fbW * 2 / 3) : 0;
     const int area = std::max(1, fbW - state.sidebarWidth);
-    bool docking = false;
-    for (const std::string& name : openInspectors(state)) docking |= !state.movedWindows.count(name);
-    int column = state.showDebug && docking ? std::clamp(fbW * 3 / 10, 300, 460) : 0;
+    int column = state.showDebug && !dockedInspectors(state).empty() ? std::clamp(fbW * 3 / 10, 300, 460) : 0;
     if (area - column < std::max(240, area * 2 / 5)) column = 0;  // no room beside the image: they float
     state.inspector = {fbW - column, 0, column, fbH};
     const int w = std::max(1, area - column), h = std::max(1, fbH);
@@ -88,9 +94,7 @@ void layOut(WindowState& state, int fbW, int fbH) {
 
 void placeInspector(WindowState& state, const std::string& name) {
     if (!inspectorDocked(state, name)) return;
-    std::vector<std::string> docked;
-    for (const std::string& open : openInspectors(state))
-        if (!state.movedWindows.count(open)) docked.push_back(open);
+    const std::vector<std::string> docked = dockedInspectors(state);
     const auto at = std::find(docked.begin(), docked.end(), name);
     if (at == docked.end()) return;
     const float x = float(state.inspector.x), width = float(state.inspector.z), height = float(state.inspector.w);
