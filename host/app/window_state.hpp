@@ -159,9 +159,13 @@ void followBudget(WindowState&, double now);
 // debug_panels.cpp: the sidebar's panels, the error overlay, the image.
 void drawSidebar(WindowState&);
 void panelErrors(const App&, WindowState&);
-void panelTrace(WindowState&);
-void legendLabels(WindowState&);
 void drawImage(WindowState&, int framebufferWidth, int framebufferHeight);
+// inspectors.cpp: the graph view, the pixel trace, the error legend's labels, the split
+// the compare line and the error pass share.
+void panelGraph(WindowState&, bool* open);
+void panelTrace(WindowState&);
+void shareSplit(WindowState&);
+void legendLabels(WindowState&);
 
 // window_input.cpp: keys, wheel and button events, and the left button's drags.
 void installCallbacks(GLFWwindow*);
