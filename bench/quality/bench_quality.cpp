@@ -96,6 +96,7 @@ struct Args {
     std::vector<std::string> sweeps;
     std::vector<std::string> also;  // more pipelines, measured as they are
     bool cartesian = false;  // every combination of the sweeps, not one knob at a time
+    bool images = false;     // write each setting's HDR frame and indirect part beside the reference's
     std::string outDir = "bench-out";
     std::string cacheDir;  // empty: outDir/cache
 };
@@ -145,13 +146,16 @@ Args parseArgs(int argc, char** argv) {
         } else if (a == "--frames") args.frames = positive(next());
         else if (a == "--repeats") args.repeats = positive(next());
         else if (a == "--cartesian") args.cartesian = true;
+        else if (a == "--images") args.images = true;
         else if (a == "--sweep") args.sweeps.push_back(next());
         else if (a == "--out") args.outDir = next();
         else if (a == "--cache") args.cacheDir = next();
         else if (a == "--help" || a == "-h") {
             std::printf("usage: kiln-bench-quality [--pipeline FILE] [--also FILE]... [--scene FILE] [--time S] [--size WxH] [--spp N]\n"
                         "                          [--frames N] [--repeats R] [--sweep PASS.PARAM=V1,V2,...]... [--cartesian]\n"
-                        "                          [--out DIR] [--cache DIR]\n");
+                        "                          [--out DIR] [--cache DIR] [--images]\n"
+                        "  --images  also write OUT/images/: each setting's composite.hdr and its indirect part,\n"
+                        "            and the reference's mean and indirect part (OpenEXR, linear radiance)\n");
             std::exit(0);
         } else usageError("unknown argument \"" + a + "\"");
     }
@@ -392,6 +396,20 @@ void indirectFigures(const FloatImage& indirect, const Reference& ref, const met
         r.indirectRatio[p] = metrics::meanLuminanceRatio(indirect, indirectA, indirectB, partMask[p]);
 }
 
+// --images: OUT/images/LABEL.exr and LABEL.indirect.exr ('/' in a label becomes '_').
+bool writeImages(const Args& args, const std::string& label, const FloatImage& image, const FloatImage& indirect) {
+    const fs::path dir = fs::path(args.outDir) / "images";
+    std::error_code ec;
+    fs::create_directories(dir, ec);
+    std::string name = label;
+    std::replace(name.begin(), name.end(), '/', '_');
+    std::string error;
+    if (!writeExr((dir / (name + ".exr")).string(), image, error) ||
+        !writeExr((dir / (name + ".indirect.exr")).string(), indirect, error))
+        return fail(label + ": " + error);
+    return true;
+}
+
 bool measure(app::App& app, const Args& args, const Setting& setting, const Reference& ref, Result& r) {
     std::string text, error;
     const std::string& pipeline = setting.pipeline.empty() ? args.pipeline : setting.pipeline;
@@ -442,8 +460,10 @@ bool measure(app::App& app, const Args& args, const Setting& setting, const Refe
     if (!app.runtime().setParam("composite", "indirect_strength", 0.0f, error)) return fail(setting.label + ": " + error);
     app.frame();
     glFinish();
-    indirectFigures(metrics::difference(image, readTexture(hdr->id, hdr->target, hdr->format, hdr->width, hdr->height)),
-                    ref, mask, partMask, r);
+    const FloatImage indirect =
+        metrics::difference(image, readTexture(hdr->id, hdr->target, hdr->format, hdr->width, hdr->height));
+    indirectFigures(indirect, ref, mask, partMask, r);
+    if (args.images && !writeImages(args, setting.label, image, indirect)) return false;
     r.counted = mask;
     // The ratios may be NaN (a region out of view): they are printed as n/a, not checked.
     for (double v : {r.errors.rmse, r.errors.relMse, r.errors.ssim, r.relMseCorrected, r.indirectRelMse, r.indirectRelMseCorrected})
@@ -654,6 +674,7 @@ int main(int argc, char** argv) {
 
     Reference ref;
     if (!loadReference(app, args, ref)) return 1;
+    if (args.images && (!writeImages(args, "reference", ref.mean, ref.meanIndirect))) return 1;
     std::vector<Result> results;
     if (!measureAll(app, args, settings, ref, results)) return 1;
     const ReferenceFigures figures = referenceFigures(ref, args, results.front().counted);
