@@ -105,6 +105,10 @@ public:
             .param(intParam("bounces", 1, 1, 8,
                             "diffuse bounces the frame shows: 1 = the voxels hold direct light and emission (the "
                             "pixels gather one bounce); each more is gathered in the voxels first"))
+            .param(enumParam("facing", "off", {"off", "back", "back_and_edge"},
+                             "directional chains (needs `normal`): back: a surface voxel a cone meets from "
+                             "behind is empty (every cone leaves its own surface that way); back_and_edge: "
+                             "edge-on too (a cone along a wall passes it, and meets an oblique wall less)"))
             .param(intChoiceParam("gather_block", 2, {1, 2},
                                   "bounces > 1: voxels per side that gather once together (2: an eighth of the cones)"))
             .param(floatParam("gather_start_offset", kGatherStartOffset, 0.0, 4.0,
@@ -126,6 +130,8 @@ public:
             return ctx.fail("bounces " + std::to_string(bounces) +
                             " needs `albedo` and `normal` bound (voxelize.albedo, voxelize.normal): what each voxel "
                             "reflects, and which way");
+        if (ctx.getEnum("facing") != "off" && !ctx.isBound("normal"))
+            return ctx.fail("facing needs `normal` bound (voxelize.normal): which way each voxel's surface faces");
         GLuint bounce = bounces > 1 ? ctx.program({.stages = {"voxel_mip/bounce.comp"}, .defines = gatherDefines(ctx, chain.width)}) : 0;
         if (bounces > 1 && !bounce) return;
         const int res = chain.width;  // = the input's (SizeRule::fromInput)
@@ -166,6 +172,8 @@ private:
         const kiln::TextureRef& fixed = ctx.output("fixed_cones");
         const std::string& mode = ctx.getEnum("mode");
         const int res = chain.width;
+        const std::string& facingMode = ctx.getEnum("facing");
+        const int facing = facingMode == "back" ? 1 : facingMode == "back_and_edge" ? 2 : 0;
         glUseProgram(iso);
         for (int level = 1; level < chain.levels; ++level) {
             const int n = std::max(1, res >> level);
@@ -187,6 +195,8 @@ private:
                     kiln::gl::bindImage(aniso, "u_src", atlas.id, L - 2, true, GL_READ_ONLY, GL_RGBA16F);
                 kiln::gl::bindImage(aniso, "u_dst", atlas.id, L - 1, true, GL_WRITE_ONLY, GL_RGBA16F);
                 glUniform1i(glGetUniformLocation(aniso, "u_fromBase"), L == 1 ? 1 : 0);
+                glUniform1i(glGetUniformLocation(aniso, "u_facing"), facing);
+                if (facing) kiln::gl::bindTexture(aniso, "u_normal", ctx.input("normal").id);
                 glUniform1i(glGetUniformLocation(aniso, "u_size"), n);
                 glDispatchCompute(groups(n), groups(n), groups(n));
             }

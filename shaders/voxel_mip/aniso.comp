@@ -8,8 +8,11 @@ layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
 layout(rgba16f, binding = 0) uniform readonly image3D u_src;   // the iso level 0, or the previous atlas level
 layout(rgba16f, binding = 1) uniform writeonly image3D u_dst;  // atlas level (octant side u_size)
 
+layout(binding = 2) uniform sampler3D u_normal;                // voxelize.normal (u_facing only)
+
 uniform int u_fromBase;  // 1: the source is the isotropic base (the same for every direction)
 uniform int u_size;      // parent voxels per side at this level
+uniform int u_facing;    // 0: off; 1: back faces empty; 2: back faces and edge-on empty (from the base only)
 
 ivec3 octant(int i) { return ivec3(i & 1, (i >> 1) & 1, i >> 2); }
 
@@ -38,10 +41,41 @@ void storeAll(ivec3 v, int first, int last, vec4 c000, vec4 c100, vec4 c010, vec
     }
 }
 
+const vec3 kDirection[6] = vec3[](vec3(1, 0, 0), vec3(-1, 0, 0), vec3(0, 1, 0), vec3(0, -1, 0), vec3(0, 0, 1), vec3(0, 0, -1));
+
+// What of a base voxel a cone travelling along d meets (u_facing > 0). A surface
+// voxel seen from behind (its mean normal m along d: the cone leaves that surface, as
+// every cone leaves its own) is empty, light and opacity both: rays from outside a
+// closed surface never meet its back. u_facing 2 empties it edge-on too (|m̂·d| < 0.05:
+// a thin plane's projected area is zero, so a cone running along a wall does not meet
+// it — nor does one that meets the wall obliquely, through this axis's share of the
+// blend, hence a knob). |m| < 1 (surfaces facing several ways in one voxel) blends
+// towards keeping it whole.
+vec4 facing(vec4 c, vec3 m, vec3 d) {
+    float f = min(length(m), 1.0);
+    if (f < 1e-3) return c;
+    float front = u_facing == 2 ? 1.0 - step(-0.05 * f, dot(m, d))  // edge-on emptied too
+                                : step(dot(m, d), 0.0);            // edge-on (m·d = 0) kept
+    return c * ((1.0 - f) + f * front);
+}
+
 void main() {
     ivec3 v = ivec3(gl_GlobalInvocationID);
     if (any(greaterThanEqual(v, ivec3(u_size)))) return;
-    if (u_fromBase == 1) {
+    if (u_fromBase == 1 && u_facing > 0) {
+        ivec3 b = 2 * v;
+        LOAD8(u_src, b);
+        vec3 m000 = texelFetch(u_normal, b, 0).xyz, m100 = texelFetch(u_normal, b + ivec3(1, 0, 0), 0).xyz,
+             m010 = texelFetch(u_normal, b + ivec3(0, 1, 0), 0).xyz, m110 = texelFetch(u_normal, b + ivec3(1, 1, 0), 0).xyz,
+             m001 = texelFetch(u_normal, b + ivec3(0, 0, 1), 0).xyz, m101 = texelFetch(u_normal, b + ivec3(1, 0, 1), 0).xyz,
+             m011 = texelFetch(u_normal, b + ivec3(0, 1, 1), 0).xyz, m111 = texelFetch(u_normal, b + ivec3(1, 1, 1), 0).xyz;
+        for (int i = 0; i < 6; ++i) {
+            vec3 d = kDirection[i];
+            storeAll(v, i, i, facing(c000, m000, d), facing(c100, m100, d), facing(c010, m010, d),
+                     facing(c110, m110, d), facing(c001, m001, d), facing(c101, m101, d), facing(c011, m011, d),
+                     facing(c111, m111, d));
+        }
+    } else if (u_fromBase == 1) {
         LOAD8(u_src, 2 * v);
         storeAll(v, 0, 5, c000, c100, c010, c110, c001, c101, c011, c111);
     } else {

@@ -501,6 +501,49 @@ TEST_CASE("voxel_mip: anisotropic levels composite front to back along their dir
     CHECK(d[3] == Approx(1.0f).margin(2e-3));
 }
 
+TEST_CASE("voxel_mip facing: a cone meets the floor from above, not from below; edge-on as the mode says",
+          "[gi][mip]") {
+    // The empty box voxelized (the floor: one lit layer at y = 0, normal +y), its first
+    // directional level read at a cell over the floor's middle: the children y = 0
+    // (floor) and y = 1 (air), so along ±x and ±z two of the four pairs are floor.
+    // Exact by construction (0 or 1 opacities; the floor voxels' mean normal is +y):
+    //   off            +y 1 (the floor in front), −y 1, ±x 0.5
+    //   back           +y 0 (a cone going up leaves the floor's back), −y 1, ±x 0.5
+    //   back_and_edge  +y 0, −y 1, ±x 0 (the floor edge-on)
+    // and the floor's light travels down only: −y keeps it, +y has none.
+    Rig rig(writeScene("empty_box.json", kEmptyBox), 32);
+    struct Expect {
+        const char* mode;
+        float up, down, sideways;
+    };
+    for (const Expect& e : {Expect{"off", 1.0f, 1.0f, 0.5f}, Expect{"back", 0.0f, 1.0f, 0.5f},
+                            Expect{"back_and_edge", 0.0f, 1.0f, 0.0f}}) {
+        INFO("facing " << e.mode);
+        rig.load(pipeline("voxel_view.color", R"(
+            {"id": "shadow", "module": "shadow", "params": {"size": 256}},
+            {"id": "voxelize", "module": "voxelize", "inputs": {"shadow_map": "shadow.depth"}, "params": {"resolution": 32}},
+            {"id": "voxel_mip", "module": "voxel_mip",
+             "inputs": {"radiance": "voxelize.radiance", "normal": "voxelize.normal"},
+             "params": {"mode": "aniso", "facing": ")" + std::string(e.mode) + R"("}},
+            {"id": "voxel_view", "module": "voxel_view", "inputs": {"voxels": "voxel_mip.iso"}})"),
+                 {"voxel_mip.aniso"});
+        rig.app.frame();
+        rig.checkNoErrors();
+        const Volume atlas = read3d(rig.tex("voxel_mip", "aniso"), 0);
+        const int half = atlas.n / 2;  // 16: level 1's side
+        auto cell = [&](int direction) {  // octant (i&1, (i>>1)&1, i>>2), cell (8, 0, 8)
+            return atlas.at(8 + (direction & 1) * half, 0 + ((direction >> 1) & 1) * half, 8 + (direction >> 2) * half);
+        };
+        const int kPlusX = 0, kMinusX = 1, kPlusY = 2, kMinusY = 3, kPlusZ = 4;
+        // Half floats: 1e-3.
+        CHECK(cell(kPlusY)[3] == Approx(e.up).margin(1e-3));
+        CHECK(cell(kMinusY)[3] == Approx(e.down).margin(1e-3));
+        for (int d : {kPlusX, kMinusX, kPlusZ}) CHECK(cell(d)[3] == Approx(e.sideways).margin(1e-3));
+        CHECK(cell(kMinusY)[0] > 0.02f);  // the lit floor's light, met from above
+        if (std::string(e.mode) != "off") CHECK(cell(kPlusY)[0] == Approx(0.0f).margin(1e-4));
+    }
+}
+
 TEST_CASE("voxel_mip fixed_cones: each direction's chain is the d²-weighted blend of the three chains facing it",
           "[gi][mip]") {
     // The 12 directions are an icosahedron: unit, and each has 5 neighbours at
