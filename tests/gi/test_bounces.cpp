@@ -17,8 +17,9 @@ using namespace kiln::test;
 
 namespace {
 
-// The rasterized pipeline of pipelines/default.json with `bounces`, voxels at 32³, the
-// chains of voxel_mip `mode` (fixed_cones, aniso or iso).
+// The rasterized pipeline of pipelines/default.json with `bounces` (voxels at 32³, the
+// voxels' faces as the default has them, 54° cones, but every pixel traced and the lamp
+// from 16 points), the chains of voxel_mip `mode` (fixed_cones, aniso or iso).
 std::string rasterPipeline(int bounces, const std::string& mode = "fixed_cones") {
     const std::string chain = mode == "iso" ? "" : R"(, ")" + mode + R"(": "voxel_mip.)" + mode + R"(")";
     return pipeline("composite.color", R"(
@@ -27,10 +28,11 @@ std::string rasterPipeline(int bounces, const std::string& mode = "fixed_cones")
         {"id": "voxelize", "module": "voxelize", "inputs": {"shadow_map": "shadow.depth"}, "params": {"resolution": 32}},
         {"id": "voxel_mip", "module": "voxel_mip",
          "inputs": {"radiance": "voxelize.radiance", "albedo": "voxelize.albedo", "normal": "voxelize.normal"},
-         "params": {"mode": ")" + mode + R"(", "bounces": )" + std::to_string(bounces) + R"(}},
+         "params": {"mode": ")" + mode + R"(", "bounces": )" + std::to_string(bounces) + R"(,
+                    "facing": ")" + (mode == "iso" ? "off" : "back") + R"(", "gather_diameter_offset": 1.0}},
         {"id": "cone_trace", "module": "cone_trace",
          "inputs": {"normal": "gbuffer.normal", "depth": "gbuffer.depth", "voxels": "voxel_mip.iso")" + chain + R"(},
-         "params": {"trace_stride": 1}},
+         "params": {"trace_stride": 1, "aperture": 54.0}},
         {"id": "composite", "module": "composite",
          "inputs": {"albedo": "gbuffer.albedo", "normal": "gbuffer.normal", "depth": "gbuffer.depth",
                     "emissive": "gbuffer.emissive", "shadow_map": "shadow.depth",
@@ -66,11 +68,14 @@ TEST_CASE("voxel_mip bounces: the white furnace — k bounces show 2 − 0.5^k o
     // 0.5^i, so a frame that shows k bounces (direct light and emission are bounce 0)
     // has radiance Σ_{i≤k} 0.5^i = 2 − 0.5^k everywhere: 1.5, 1.75, 1.875, … → 2. The
     // cone tracer's energy is the whole question: a cone that loses light through a
-    // wall or misses its weight shows up here, in every bounce. Measured within 0.41 %
-    // (k = 1) and 0.1 % (k = 2…4); the tolerance, 2 %, leaves room for another cone
+    // wall or misses its weight shows up here, in every bounce. Measured (fixed_cones)
+    // 1.509 / 1.746 / 1.861 / 1.916: within 0.6 / 0.2 / 0.7 / 1.1 %; the voxels' gather
+    // samples a whole diameter off their surface (the default's gather_diameter_offset
+    // 1) skip a little light near the walls, as half a diameter does not (1.509 /
+    // 1.756 / 1.880 / 1.942). The tolerance, 2 %, leaves room for another cone
     // schedule and still fails a bounce that is missing (1.5 against 1.75) or a cone
     // set that loses a twentieth of the light. Both directional modes of the chains
-    // the bounces are gathered through (aniso: 1.507 / 1.753 / 1.876 / 1.937). Not iso:
+    // the bounces are gathered through (aniso: 1.510 / 1.747 / 1.862 / 1.918). Not iso:
     // its averaged coarse levels let cones through the one-voxel walls, so a furnace
     // frame shows 1.21 at k = 1 and 1.27 at k = 4 — the course design's self-occlusion finding,
     // seen as lost energy.
@@ -95,13 +100,13 @@ TEST_CASE("voxel_mip bounces: each bounce adds what the path tracer's next path 
     // reference with max_bounces = k + 1 (path vertices: 1 = direct light only) holds
     // exactly k bounces, as the raster frame with voxel_mip.bounces = k. Its mean over
     // ~500 pixels × 256 paths has a standard deviation under 0.5 %.
-    // Measured (32³, 60° fixed cones): the frame is 0.969 / 1.040 / 1.091 of the
-    // reference for k = 1 / 2 / 3, and bounces 2 and 3 add 1.50× and 1.78× what the
-    // reference's do: the voxels' gather over-reflects (a surface sees part of itself
-    // through the coarse levels: a diameter offset of 1 instead of 0.5 brings it to
-    // 1.18× / 1.21×), the open issue this test pins. Asserted: every frame within 10 %,
-    // every bounce adds light, and each increment within a factor of 2 of the
-    // reference's (a bounce that is missing, doubled or reflected twice fails).
+    // Measured (32³, 54° fixed cones, facing voxels): the frame is 0.952 / 1.000 / 1.022
+    // of the reference for k = 1 / 2 / 3, and bounces 2 and 3 add 1.31× and 1.31× what
+    // the reference's do. Before the voxels' faces (every voxel lit and opaque whichever
+    // way a cone met it, 60°): 0.969 / 1.040 / 1.091 and 1.50× / 1.78× — a surface lit
+    // and shadowed itself through the coarse levels. The 1.31× left is the open item.
+    // Asserted: every frame within 5 %, every bounce adds light, and each increment
+    // within 1.5× of the reference's (the old voxels' third bounce fails that).
     nlohmann::json scene = nlohmann::json::parse(std::ifstream(KILN_SOURCE_DIR "/scenes/cornell.json"));
     scene["fireballs"] = nlohmann::json::array();
     Rig rig(writeScene("still_bounces.json", scene.dump()), 24);
@@ -117,13 +122,13 @@ TEST_CASE("voxel_mip bounces: each bounce adds what the path tracer's next path 
         const double raster = metrics::meanLuminance(frame, lit);
         INFO("bounces " << k << ": raster " << raster << ", reference " << reference << " (ratio " << raster / reference
                         << ")");
-        CHECK(std::abs(raster / reference - 1.0) < 0.10);
+        CHECK(std::abs(raster / reference - 1.0) < 0.05);
         if (k > 1) {
             const double addedRaster = raster - previousRaster, addedReference = reference - previousReference;
             INFO("bounce " << k << " adds " << addedRaster << " (raster) against " << addedReference << " (reference)");
             CHECK(addedReference > 0.0);
-            CHECK(addedRaster > 0.5 * addedReference);
-            CHECK(addedRaster < 2.0 * addedReference);
+            CHECK(addedRaster > addedReference / 1.5);
+            CHECK(addedRaster < 1.5 * addedReference);
         }
         previousRaster = raster, previousReference = reference;
     }
@@ -131,9 +136,10 @@ TEST_CASE("voxel_mip bounces: each bounce adds what the path tracer's next path 
 
 TEST_CASE("voxel_mip bounces and composite's traced lamp refuse what they cannot honour, by name, and recover",
           "[gi][bounces][errors]") {
-    // Bounces need what each voxel reflects and which way it faces; the traced lamp
-    // needs cone_trace's output. Without them the pass fails with the missing binding
-    // named (the host shows it and keeps running), and binding them clears it.
+    // Bounces need what each voxel reflects and which way it faces, so do the voxels'
+    // faces (facing); the traced lamp needs cone_trace's output. Without them the pass
+    // fails with the missing binding named (the host shows it and keeps running), and
+    // binding them clears it.
     Rig rig(writeScene("empty_box_errors.json", kEmptyBox), 24);
     std::string text = rasterPipeline(2);
     const std::string surfaces = R"(, "albedo": "voxelize.albedo", "normal": "voxelize.normal")";
@@ -143,6 +149,13 @@ TEST_CASE("voxel_mip bounces and composite's traced lamp refuse what they cannot
     auto active = rig.app.runtime().activeErrors();
     REQUIRE(active.size() == 1);
     CHECK_THAT(active[0], Catch::Contains("bounces 2 needs `albedo` and `normal` bound (voxelize.albedo, voxelize.normal)"));
+    text = rasterPipeline(1);  // one bounce, the voxels' faces on: they need `normal` alone
+    text.replace(text.find(surfaces), surfaces.size(), "");
+    rig.load(text, {"composite.hdr"});
+    rig.app.frame();
+    active = rig.app.runtime().activeErrors();
+    REQUIRE(active.size() == 1);
+    CHECK_THAT(active[0], Catch::Contains("facing needs `normal` bound (voxelize.normal)"));
 
     text = rasterPipeline(2);
     const std::string indirect = R"(,

@@ -176,15 +176,21 @@ TEST_CASE("kiln-bench-render --grow: one growth row per count, the first the bas
 TEST_CASE("the default pipeline is closer to the path-traced reference than the course report's design (course.json)",
           "[integration][bench][quality]") {
     // The claim behind the default's settings, checked against the independent path
-    // tracer rather than against a finer run of the rasterizer: 96² at t = 0.5 s, a
-    // 256-path reference in two seeded halves (~3 min here; deterministic figures).
-    // Measured (noise-corrected relMSE): 0.0518 against 0.0717, the indirect part 0.0864
-    // against 0.120; the mean luminance 1.000× the reference's against 0.799× (issue
-    // 22: the course design's one bounce misses a fifth of the light; ±0.002 from the
-    // reference's noise). SSIM is withheld at this path count (the halves disagree).
+    // tracer rather than against a finer run of the rasterizer: 128² at t = 0.5 s, a
+    // 256-path reference in two seeded halves (~5 min here; deterministic figures).
+    // 128², the benchmark's size, not less: the default traces one pixel in 4×4 of a
+    // half-size image, and at 96² those 12×12 samples smear the lamp's light on the
+    // ceiling (0.90× there, against 0.98× at 128²).
+    // Measured (noise-corrected relMSE): 0.0320 against 0.0547, the indirect part 0.0373
+    // against 0.120; the mean luminance 0.960× the reference's against 0.803× (±0.001
+    // from the reference's noise; issue 22: the course design's one bounce misses a
+    // fifth of the light, the default's two bounces all but the third and later ones,
+    // about 4 % here — its voxels no longer light and shadow themselves, which had
+    // stood in for them: 0.0394 and 0.987× before). SSIM is withheld at this path count
+    // (the halves disagree).
     const std::string out = std::string(TEST_OUTPUT_DIR) + "/bench-quality-default-vs-course";
     Run r = runProgram(KILN_BENCH_QUALITY,
-                       "--size 96x96 --spp 256 --frames 1 --repeats 1 --sweep composite.exposure=1 "
+                       "--size 128x128 --spp 256 --frames 1 --repeats 1 --sweep composite.exposure=1 "
                        "--also pipelines/course.json --out " + out,
                        600);
     INFO(r.out << r.err);
@@ -205,6 +211,7 @@ TEST_CASE("the default pipeline is closer to the path-traced reference than the 
     CHECK(relMse[0] < relMse[1]);
     CHECK(indirect[0] < indirect[1]);
     INFO("mean luminance ÷ the reference's: default " << light[0] << ", course " << light[1]);
-    CHECK(std::abs(light[0] - 1.0) < 0.03);
+    CHECK(light[0] > 0.95);
+    CHECK(light[0] < 1.03);
     CHECK(light[1] < 0.9);
 }
