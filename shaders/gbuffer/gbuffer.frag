@@ -1,26 +1,25 @@
 #version 450 core
 // G-buffer: albedo (sRGB-free linear rgb), world-space normal, emitted radiance.
 #include "common/frame.glsl"
-#include "common/instances.glsl"
 
 layout(binding = 1) uniform sampler2D u_wood;  // the floor's grain over x, z in [-1,1] (gbuffer/wood.comp)
 
 in vec3 v_world;
 in vec3 v_normal;
-flat in uint v_instance;
+flat in vec4 v_albedo;    // rgb, a = material (0 plain, 1 wood grain)
+flat in vec4 v_emissive;  // rgb radiance, a = highlight
 
 layout(location = 0) out vec4 o_albedo;
 layout(location = 1) out vec4 o_normal;    // xyz world-space unit normal, w = 1 where geometry
 layout(location = 2) out vec4 o_emissive;  // rgb radiance
 
 void main() {
-    KilnInstance inst = kiln_instances[v_instance];
-    vec3 albedo = inst.albedo.rgb;
-    if (inst.albedo.a > 0.5) albedo = texture(u_wood, v_world.xz * 0.5 + 0.5).rgb;
+    vec3 albedo = v_albedo.rgb;
+    if (v_albedo.a > 0.5) albedo = texture(u_wood, v_world.xz * 0.5 + 0.5).rgb;
     vec3 n = normalize(v_normal);
     if (!gl_FrontFacing) n = -n;
-    vec3 emissive = inst.emissive.rgb;
-    if (inst.emissive.a > 0.5) emissive += vec3(0.25, 0.2, 0.05);  // the picked tumbler glows
+    vec3 emissive = v_emissive.rgb;
+    if (v_emissive.a > 0.5) emissive += vec3(0.25, 0.2, 0.05);  // the picked tumbler glows
     o_albedo = vec4(albedo, 1.0);
     o_normal = vec4(n, 1.0);
     o_emissive = vec4(emissive, 1.0);

@@ -3,9 +3,9 @@
 // sphere's normal (in view space from gl_PointCoord, then to world), no albedo, its
 // emission. Depth stays the centre's: a particle spans a few pixels.
 #include "common/frame.glsl"
-#include "common/instances.glsl"
 
-flat in uint v_instance;
+flat in vec3 v_albedo;
+flat in vec3 v_emissive;
 
 layout(location = 0) out vec4 o_albedo;
 layout(location = 1) out vec4 o_normal;
@@ -17,8 +17,7 @@ void main() {
     float r2 = dot(d, d);
     if (r2 > 1.0) discard;
     vec3 nView = vec3(d, sqrt(1.0 - r2));
-    KilnInstance inst = kiln_instances[v_instance];
-    o_albedo = vec4(inst.albedo.rgb, 1.0);
+    o_albedo = vec4(v_albedo, 1.0);
     o_normal = vec4(normalize(transpose(mat3(u_view)) * nView), 1.0);
-    o_emissive = vec4(inst.emissive.rgb, 1.0);
+    o_emissive = vec4(v_emissive, 1.0);
 }

@@ -6,7 +6,9 @@
 #include "common/instances.glsl"
 
 uniform uint u_first;
-flat out uint v_instance;
+// The material as flat varyings (read once a point, not once a fragment: gbuffer.vert).
+flat out vec3 v_albedo;
+flat out vec3 v_emissive;
 
 void main() {
     KilnInstance inst = kiln_instances[u_first + uint(gl_VertexID)];
@@ -14,5 +16,6 @@ void main() {
     gl_Position = u_viewProj * vec4(kilnSphereCentre(inst), 1.0);
     // Diameter in pixels: 2r · (focal length in pixels) / depth.
     gl_PointSize = max(2.0 * radius * u_proj[1][1] * 0.5 * u_outputSize.y / max(gl_Position.w, 1e-4), 1.0);
-    v_instance = u_first + uint(gl_VertexID);
+    v_albedo = inst.albedo.rgb;
+    v_emissive = inst.emissive.rgb;
 }
