@@ -14,8 +14,8 @@
 // would not pass a threshold of 1 anyway. No lighting/composite split is needed.
 //
 // Nothing bright: the bright-pass also raises a flag in a 4-byte buffer (an atomicOr
-// from each block with a texel above the threshold) that the blur reads; with the flag
-// down every blur fragment writes black without a single tap. The flag never comes
+// from each block with a texel above the threshold) that the blur's vertex shader
+// reads; with the flag down it draws nothing over the targets cleared to black. The flag never comes
 // back to the CPU: a read-back right after the dispatch would stall the CPU on the GPU
 // every frame.
 #include <kiln/pass.hpp>
@@ -46,7 +46,7 @@ public:
 
     void execute(kiln::PassContext& ctx) override {
         GLuint brightPass = ctx.program({.stages = {"bloom/bright.comp"}});
-        GLuint blur = ctx.program({.stages = {"common/fullscreen.vert", "bloom/blur.frag"}});
+        GLuint blur = ctx.program({.stages = {"bloom/blur.vert", "bloom/blur.frag"}});
         if (!brightPass || !blur) return;
         const kiln::TextureRef& in = ctx.input("color");
         const kiln::TextureRef& bright = ctx.internal("bright");
@@ -68,13 +68,17 @@ public:
         glUseProgram(blur);
         glUniform1i(glGetUniformLocation(blur, "u_radius"), (ctx.getInt("radius") + 1) / 2);
         glUniform1f(glGetUniformLocation(blur, "u_sigma"), std::max(0.5f, float(ctx.getInt("radius")) * 0.25f));
+        // Black where nothing is drawn (blur.vert collapses the triangle when nothing is bright).
+        const float black[4] = {0.0f, 0.0f, 0.0f, 1.0f};
         if (!ctx.framebuffer({"ping"})) return;
+        glClearBufferfv(GL_COLOR, 0, black);
         glUniform2f(glGetUniformLocation(blur, "u_direction"), 1.0f, 0.0f);
         glUniform1f(glGetUniformLocation(blur, "u_gain"), 1.0f);
         kiln::gl::bindStorageBuffer(blur, "AnyBright", anyBright_.id());
         kiln::gl::bindTexture(blur, "u_src", bright.id);
         ctx.drawFullscreenTriangle();
         if (!ctx.framebuffer({"bloom"})) return;
+        glClearBufferfv(GL_COLOR, 0, black);
         glUniform2f(glGetUniformLocation(blur, "u_direction"), 0.0f, 1.0f);
         glUniform1f(glGetUniformLocation(blur, "u_gain"), ctx.getFloat("intensity"));
         kiln::gl::bindTexture(blur, "u_src", ctx.internal("ping").id);

@@ -1,21 +1,16 @@
 #version 450 core
 // One axis of the separable Gaussian (σ = u_sigma, 2·radius+1 taps, weights
-// normalised) over the half-resolution bright pass (bloom/bright.comp).
+// normalised) over the half-resolution bright pass (bloom/bright.comp). Drawn only
+// when something passed the threshold (bloom/blur.vert).
 layout(binding = 0) uniform sampler2D u_src;
 uniform vec2 u_direction;
 uniform int u_radius;
 uniform float u_sigma;
 uniform float u_gain;
-// Set by bloom/bright.comp when some input texel is above the threshold; else black.
-layout(std430, binding = 1) readonly buffer AnyBright { uint u_anyBright; };
 
 layout(location = 0) out vec4 o_color;
 
 void main() {
-    if (u_anyBright == 0u) {
-        o_color = vec4(0.0, 0.0, 0.0, 1.0);
-        return;
-    }
     ivec2 p = ivec2(gl_FragCoord.xy);
     ivec2 last = textureSize(u_src, 0) - 1;
     vec3 sum = vec3(0.0);
