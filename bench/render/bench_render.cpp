@@ -12,7 +12,9 @@
 // pairs; "frame ms" is wall time per frame with a glFinish, which on llvmpipe is what
 // a user waits for. Configurations are measured in rounds: each round visits every
 // configuration once (a slow minute of a shared machine lands on all of them alike);
-// the figures are medians over frames, then over rounds.
+// the figures are medians over frames, then over rounds. Each round also times an
+// empty full-screen pass (the floor every screen pass pays); every pass is reported
+// as a multiple of it too.
 //
 // Each configuration first simulates --settle seconds (default 1.5, without
 // rendering) so the fire's particles reach their steady count: the first frames of a
@@ -194,6 +196,69 @@ struct Measured {
     std::vector<double> frameMs, particles;
 };
 
+// The floor: the time of an empty full-screen pass at the output size (a triangle over an
+// RGBA16F target, each pixel's coordinates written: no input, no math), the median of
+// `draws` timed draws after 3 warm-up ones. Every screen pass costs at least this; the
+// tables report each pass as a multiple of it. 0 when the program does not build.
+double emptyPassMs(int width, int height, int draws) {
+    static const char* kVertex = R"(#version 450 core
+        void main() {
+            vec2 p = vec2((gl_VertexID << 1) & 2, gl_VertexID & 2);
+            gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
+        })";
+    static const char* kFragment = R"(#version 450 core
+        layout(location = 0) out vec4 o_color;
+        void main() { o_color = vec4(gl_FragCoord.xy * 1e-3, 0.0, 1.0); })";
+    auto stage = [](GLenum type, const char* source) {
+        const GLuint s = glCreateShader(type);
+        glShaderSource(s, 1, &source, nullptr);
+        glCompileShader(s);
+        return s;
+    };
+    const GLuint vs = stage(GL_VERTEX_SHADER, kVertex), fs = stage(GL_FRAGMENT_SHADER, kFragment);
+    const GLuint program = glCreateProgram();
+    glAttachShader(program, vs);
+    glAttachShader(program, fs);
+    glLinkProgram(program);
+    glDeleteShader(vs);
+    glDeleteShader(fs);
+    GLint linked = 0;
+    glGetProgramiv(program, GL_LINK_STATUS, &linked);
+    GLuint texture = 0, framebuffer = 0, vao = 0;
+    glCreateTextures(GL_TEXTURE_2D, 1, &texture);
+    glTextureStorage2D(texture, 1, GL_RGBA16F, width, height);
+    glCreateFramebuffers(1, &framebuffer);
+    glNamedFramebufferTexture(framebuffer, GL_COLOR_ATTACHMENT0, texture, 0);
+    glCreateVertexArrays(1, &vao);
+    std::vector<double> ms;
+    if (linked) {
+        glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
+        glViewport(0, 0, width, height);
+        glDisable(GL_DEPTH_TEST);
+        glUseProgram(program);
+        glBindVertexArray(vao);
+        // Wall time around each draw, with a glFinish on both sides: timestamp queries
+        // around this one draw (flushed or not) read 0.05 ms on llvmpipe, a fraction of
+        // it; a pass's queries bracket its framebuffer's whole scene.
+        for (int i = 0; i < draws + 3; ++i) {
+            glFinish();
+            const auto t0 = std::chrono::steady_clock::now();
+            glDrawArrays(GL_TRIANGLES, 0, 3);
+            glFinish();
+            const auto t1 = std::chrono::steady_clock::now();
+            if (i >= 3) ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+        }
+        glBindVertexArray(0);
+        glUseProgram(0);
+        glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    }
+    glDeleteVertexArrays(1, &vao);
+    glDeleteFramebuffers(1, &framebuffer);
+    glDeleteTextures(1, &texture);
+    glDeleteProgram(program);
+    return ms.empty() ? 0.0 : median(ms);
+}
+
 // One round of `config`: a fresh app, --settle seconds simulated, 3 warm-up frames,
 // then `frames` timed ones.
 bool measureRound(const Args& args, const Config& config, const std::string& text, Measured& m, std::string& error) {
@@ -237,17 +302,21 @@ bool measureRound(const Args& args, const Config& config, const std::string& tex
     return true;
 }
 
-void report(const Config& config, Measured& m, std::ofstream& csv) {
-    std::printf("%s\n  %-14s %10s %10s\n", config.label.c_str(), "pass", "gpu ms", "cpu ms");
+// floorMs: the empty pass's (emptyPassMs); 0 leaves the multiples out.
+void report(const Config& config, Measured& m, double floorMs, std::ofstream& csv) {
+    std::printf("%s\n  %-14s %10s %10s %9s\n", config.label.c_str(), "pass", "gpu ms", "cpu ms", "x floor");
     double total = 0;
+    auto multiple = [&](double ms) { return floorMs > 0.0 ? ms / floorMs : 0.0; };
     for (auto& id : m.order) {
         if (!m.gpu.count(id)) continue;
         double g = median(m.gpu[id]), c = median(m.cpu[id]);
         total += g;
-        std::printf("  %-14s %10.2f %10.2f\n", id.c_str(), g, c);
-        csv << '"' << config.label << "\"," << id << ",," << g << "," << c << "," << median(m.frameMs) << "\n";
+        std::printf("  %-14s %10.2f %10.2f %9.1f\n", id.c_str(), g, c, multiple(g));
+        csv << '"' << config.label << "\"," << id << ",," << g << "," << c << "," << median(m.frameMs) << ","
+            << multiple(g) << "\n";
     }
-    std::printf("  %-14s %10.2f   frame (wall, glFinish) %.2f ms\n\n", "sum", total, median(m.frameMs));
+    std::printf("  %-14s %10.2f %10s %9.1f   frame (wall, glFinish) %.2f ms\n\n", "sum", total, "", multiple(total),
+                median(m.frameMs));
 }
 
 }  // namespace
@@ -295,7 +364,7 @@ int main(int argc, char** argv) {
     fs::create_directories(args.outDir);
     const std::string csvPath = (fs::path(args.outDir) / "render.csv").string();
     std::ofstream csv(csvPath);
-    csv << "config,pass,module,gpu_ms,cpu_ms,frame_ms\n";
+    csv << "config,pass,module,gpu_ms,cpu_ms,frame_ms,x_floor\n";
     std::vector<std::string> texts(configs.size());
     for (size_t i = 0; i < configs.size(); ++i)
         if (!applyOverrides(slurp(configs[i].pipeline), configs[i].overrides, texts[i], error)) {
@@ -303,13 +372,19 @@ int main(int argc, char** argv) {
             return 1;
         }
     std::vector<Measured> measured(configs.size());
-    for (int round = 0; round < args.repeats; ++round)
+    std::vector<double> floors;  // per round, measured beside the configurations
+    for (int round = 0; round < args.repeats; ++round) {
+        floors.push_back(emptyPassMs(args.width, args.height, args.frames));
         for (size_t i = 0; i < configs.size(); ++i)
             if (!measureRound(args, configs[i], texts[i], measured[i], error)) {
                 std::fprintf(stderr, "kiln-bench-render: error: %s: %s\n", configs[i].pipeline.c_str(), error.c_str());
                 return 1;
             }
-    for (size_t i = 0; i < configs.size(); ++i) report(configs[i], measured[i], csv);
+    }
+    const double floorMs = median(floors);
+    std::printf("floor: an empty full-screen pass at %dx%d (its coordinates written to RGBA16F) takes %.2f ms (wall, glFinish)\n\n",
+                args.width, args.height, floorMs);
+    for (size_t i = 0; i < configs.size(); ++i) report(configs[i], measured[i], floorMs, csv);
     if (!args.growKind.empty()) reportGrowth(args, configs, measured);
     std::printf("wrote %s\n", csvPath.c_str());
     return 0;

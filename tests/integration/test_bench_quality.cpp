@@ -153,6 +153,26 @@ TEST_CASE("kiln-bench-render --grow: one growth row per count, the first the bas
     CHECK(std::filesystem::file_size(out + "/growth.png") > 1000);
     // The grown scene files are what the simulation loaded: four fireballs in the second.
     CHECK(slurp(out + "/scene-fireballs-4.json").find("\"fireballs\"") != std::string::npos);
+    // The floor (an empty full-screen pass) is measured and every pass reported as a
+    // multiple of it: in render.csv, x_floor = gpu_ms / floor for every row.
+    const size_t at = r.out.find("floor: an empty full-screen pass at 32x32");
+    REQUIRE(at != std::string::npos);
+    const double floorMs = std::stod(r.out.substr(r.out.find(" takes ", at) + 7));
+    CHECK(floorMs > 0.0);
+    std::istringstream render(slurp(out + "/render.csv"));
+    std::getline(render, line);
+    CHECK(line == "config,pass,module,gpu_ms,cpu_ms,frame_ms,x_floor");
+    int passRows = 0;
+    while (std::getline(render, line)) {
+        std::vector<std::string> cells;
+        std::istringstream row(line);
+        for (std::string cell; std::getline(row, cell, ',');) cells.push_back(cell);
+        REQUIRE(cells.size() == 7);
+        // The printed floor has two decimals; the CSV's multiple is of the unrounded one.
+        CHECK(std::stod(cells[6]) == Approx(std::stod(cells[3]) / floorMs).epsilon(0.01 / floorMs + 1e-3));
+        ++passRows;
+    }
+    CHECK(passRows >= 2 * 5);  // two configurations, every pass of the default
 
     for (const char* bad : {"--grow comets=1", "--grow fireballs=x", "--grow fireballs=-1", "--settle 99"}) {
         Run b = runProgram(KILN_BENCH_RENDER, std::string(bad) + " --out " + out, 60);
