@@ -374,7 +374,7 @@ int main(int argc, char** argv) {
     std::vector<Measured> measured(configs.size());
     std::vector<double> floors;  // per round, measured beside the configurations
     for (int round = 0; round < args.repeats; ++round) {
-        floors.push_back(emptyPassMs(args.width, args.height, args.frames));
+        floors.push_back(emptyPassMs(args.width, args.height, std::max(args.frames, 20)));
         for (size_t i = 0; i < configs.size(); ++i)
             if (!measureRound(args, configs[i], texts[i], measured[i], error)) {
                 std::fprintf(stderr, "kiln-bench-render: error: %s: %s\n", configs[i].pipeline.c_str(), error.c_str());
