@@ -40,6 +40,16 @@
 // nothing to converge or to lag behind motion), so the frame shows exactly k bounces
 // and the path tracer with max_bounces = k + 1 is its ground truth
 // (tests/gi/test_bounces.cpp, with the white furnace's 2 − 0.5^k).
+//
+// Facing (`facing`, needs `normal`). A voxel holds one radiance and one opacity; a
+// cone leaving a surface met that surface's own voxels through the coarse levels, lit
+// by them and shadowed by them. With `back`, directional level 1 is built from the
+// base with each surface voxel that the direction meets from behind (its mean normal
+// along the direction of travel) emptied: rays from outside a closed surface never
+// meet its back (shaders/voxel_mip/aniso.comp). With the gather a diameter off its
+// surfaces it cut the over-reflection of a third bounce from 1.78× to 1.31× the path
+// tracer's increment, and with 54° pixel cones took the default's relMSE from 0.0443
+// to 0.0311 (README, "The voxels' faces").
 #include <kiln/pass.hpp>
 
 #include <algorithm>
@@ -52,7 +62,8 @@ namespace {
 // The voxels' gather (bounce.comp) marches its cones as cone_trace does with its
 // defaults: 60° cones on the octave schedule (one lookup per mip level, where the
 // cone's diameter is that level's voxel, 0.87 diameters apart), pushed one voxel off the
-// surface and half of each sample's diameter further.
+// surface and half of each sample's diameter further (the default pipeline: a whole
+// diameter, with `facing`).
 constexpr float kGatherStartOffset = 1.0f;
 constexpr float kGatherDiameterOffset = 0.5f;
 kiln::Defines gatherDefines(kiln::PassContext& ctx, int res) {

@@ -9,6 +9,7 @@
 #include <sstream>
 #include <vector>
 
+#include "kiln/image_io.hpp"
 #include "support/run_kiln.hpp"
 
 using namespace kiln::test;
@@ -211,7 +212,7 @@ TEST_CASE("the default pipeline is closer to the path-traced reference than the 
     const std::string out = std::string(TEST_OUTPUT_DIR) + "/bench-quality-default-vs-course";
     Run r = runProgram(KILN_BENCH_QUALITY,
                        "--size 128x128 --spp 256 --frames 1 --repeats 1 --sweep composite.exposure=1 "
-                       "--also pipelines/course.json --out " + out,
+                       "--also pipelines/course.json --images --out " + out,
                        600);
     INFO(r.out << r.err);
     REQUIRE(r.exitCode == 0);
@@ -234,4 +235,20 @@ TEST_CASE("the default pipeline is closer to the path-traced reference than the 
     CHECK(light[0] > 0.95);
     CHECK(light[0] < 1.03);
     CHECK(light[1] < 0.9);
+
+    // --images: each setting's frame and indirect part and the reference's, at the size;
+    // the indirect part holds light, less than the frame it was taken from.
+    for (const char* name : {"reference", "default", "course", "composite.exposure=1"}) {
+        INFO(name);
+        kiln::FloatImage frame, indirect;
+        std::string error;
+        REQUIRE(kiln::readExr(out + "/images/" + name + ".exr", frame, error));
+        REQUIRE(kiln::readExr(out + "/images/" + name + ".indirect.exr", indirect, error));
+        CHECK(frame.width == 128);
+        CHECK(indirect.height == 128);
+        double sumFrame = 0, sumIndirect = 0;
+        for (size_t i = 0; i < frame.pixels.size(); ++i) sumFrame += frame.pixels[i], sumIndirect += indirect.pixels[i];
+        CHECK(sumIndirect > 0.0);
+        CHECK(sumIndirect < sumFrame);
+    }
 }
