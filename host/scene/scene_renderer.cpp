@@ -13,9 +13,8 @@ void SceneRenderer::buildMeshes(const SceneLook& look) {
     std::array<MeshData, kMeshCount> data = {
         makeQuad(),
         makeLampDome(look.lampCentre, look.lampRadius, 3, 1.0f),
-        makeTumbler(look.tumblerB, look.tumblerT, look.tumblerAlpha, kTumblerSlices[0], kTumblerStacks[0]),
-        makeTumbler(look.tumblerB, look.tumblerT, look.tumblerAlpha, kTumblerSlices[1], kTumblerStacks[1]),
-        makeTumbler(look.tumblerB, look.tumblerT, look.tumblerAlpha, 12, 4),  // for voxelization
+        makeTumbler(look.tumblerB, look.tumblerT, look.tumblerAlpha, 48, 16),
+        makeTumbler(look.tumblerB, look.tumblerT, look.tumblerAlpha, 12, 4),
         makeUvSphere(kSphereSegments[0], 16),  // spheres by size on screen (sphereLevelFor): near,
         makeUvSphere(kSphereSegments[1], 8),   // mid,
         makeUvSphere(kSphereSegments[2], 6),   // far, and for voxelization
@@ -54,7 +53,6 @@ void SceneRenderer::buildMeshes(const SceneLook& look) {
 
 void SceneRenderer::setLook(const SceneLook& look) {
     buildMeshes(look);
-    tumblerRadius_ = look.tumblerB;
     staticInstances_.clear();
     auto wall = [&](glm::mat4 m, glm::vec3 albedo, float material) {
         staticInstances_.push_back({m, glm::vec4(albedo, material), glm::vec4(look.wallEmission, 0.0f)});
@@ -113,27 +111,23 @@ void SceneRenderer::setViewer(glm::vec3 eye, float pixelsPerUnit) {
     if (eye == eye_ && pixelsPerUnit == pixelsPerUnit_) return;
     eye_ = eye;
     pixelsPerUnit_ = pixelsPerUnit;
-    dirty_ = true;  // the bodies' levels follow the camera (their contents do not)
+    dirty_ = true;  // the spheres' levels follow the camera (their contents do not)
 }
 
 // At a third of the triangles for the usual 20–40-px marble (measured: 100 marbles at
 // 720² cost 1.21× the 3-marble frame with one 24-segment mesh, 1.08× with these).
-void SceneRenderer::sortBodiesBySize() {
+void SceneRenderer::sortSpheresBySize() {
     size_t first = 0;
     int k = 0;
-    auto pixels = [&](const GpuInstance& g, float radius) {
-        const float distance = std::max(glm::length(glm::vec3(g.model[3]) - eye_), 1e-3f);
-        return radius / distance * pixelsPerUnit_;
-    };
     for (SceneCategory c : {kSceneTumblers, kSceneMarbles, kSceneFireballs}) {
         const size_t n = count(c);
-        auto begin = bodyInstances_.begin() + std::ptrdiff_t(first), end = begin + std::ptrdiff_t(n);
-        if (c == kSceneTumblers) {
-            auto mid = std::stable_partition(
-                begin, end, [&](const GpuInstance& g) { return tumblerLevelFor(pixels(g, tumblerRadius_)) == 0; });
-            tumblerLevels_ = {uint32_t(mid - begin), uint32_t(end - mid)};
-        } else {
-            auto level = [&](const GpuInstance& g) { return sphereLevelFor(pixels(g, glm::length(glm::vec3(g.model[0])))); };
+        if (c != kSceneTumblers) {
+            auto level = [&](const GpuInstance& g) {
+                const float radius = glm::length(glm::vec3(g.model[0]));
+                const float distance = std::max(glm::length(glm::vec3(g.model[3]) - eye_), 1e-3f);
+                return sphereLevelFor(radius / distance * pixelsPerUnit_);
+            };
+            auto begin = bodyInstances_.begin() + std::ptrdiff_t(first), end = begin + std::ptrdiff_t(n);
             auto mid = std::stable_partition(begin, end, [&](const GpuInstance& g) { return level(g) == 0; });
             auto far = std::stable_partition(mid, end, [&](const GpuInstance& g) { return level(g) == 1; });
             sphereLevels_[size_t(k++)] = {uint32_t(mid - begin), uint32_t(far - mid), uint32_t(end - far)};
@@ -166,17 +160,7 @@ void SceneRenderer::rebuildGroups() {
     // far), particles.
     add(kQuad, kQuad, kSceneBox);
     add(kLamp, kLamp, kSceneLamp);
-    if (const uint32_t n = count(kSceneTumblers); n > 0) {
-        const MeshId meshes[2] = {kTumblerHigh, kTumblerMid};
-        uint32_t at = cursor;
-        for (int i = 0; i < 2; ++i) {
-            if (tumblerLevels_[size_t(i)] > 0)
-                groups_.push_back({meshes[i], kSceneTumblers, Lod::High, false, at, tumblerLevels_[size_t(i)]});
-            at += tumblerLevels_[size_t(i)];
-        }
-        groups_.push_back({kTumblerLow, kSceneTumblers, Lod::Low, false, cursor, n});
-        cursor += n;
-    }
+    add(kTumblerHigh, kTumblerLow, kSceneTumblers);
     addSpheres(kSceneMarbles, sphereLevels_[0]);
     addSpheres(kSceneFireballs, sphereLevels_[1]);
     add(kParticle, kParticle, kSceneParticles);
@@ -184,7 +168,7 @@ void SceneRenderer::rebuildGroups() {
 
 void SceneRenderer::upload() {
     if (!dirty_) return;
-    sortBodiesBySize();
+    sortSpheresBySize();
     rebuildGroups();
     std::vector<GpuInstance> all;
     all.reserve(staticInstances_.size() + bodyInstances_.size() + particleInstances_.size());

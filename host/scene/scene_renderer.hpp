@@ -56,17 +56,6 @@ constexpr float kSphereNearPx = 48.0f, kSphereFarPx = 12.0f;
 inline int sphereLevelFor(float radiusPx) { return radiusPx >= kSphereNearPx ? 0 : radiusPx >= kSphereFarPx ? 1 : 2; }
 inline constexpr int kSphereSegments[3] = {32, 16, 10};
 
-// The tumbler mesh for a tumbler whose lower cap (radius tumblerB) spans `radiusPx`
-// pixels on screen: 0 = 48 slices × 16 stacks a cap, 1 = 24 × 8. The polygon strays
-// from the surface by at most r·(1 − cos(π/slices)) around the axis and r·(1 − cos(θ/2))
-// along the profile (θ = the lower cap's 110° over its stacks); the threshold keeps both
-// under a pixel up to a 400-px radius (tests/integration/test_scene.cpp). The finer
-// mesh only where it shows: it cost the G-buffer 3.8 ms and the shadow map 1.8 ms at
-// 720², for tumblers 30-45 px in radius.
-constexpr float kTumblerNearPx = 100.0f;
-inline int tumblerLevelFor(float radiusPx) { return radiusPx >= kTumblerNearPx ? 0 : 1; }
-inline constexpr int kTumblerSlices[2] = {48, 24}, kTumblerStacks[2] = {16, 8};
-
 class SceneRenderer final : public run::SceneDraw {
 public:
     // (Re)builds every mesh (the lamp dome and the tumblers follow the look) and the
@@ -74,7 +63,7 @@ public:
     void setLook(const SceneLook&);
     void setBodies(const std::vector<BodyInstance>&);
     void setParticles(const std::vector<ParticleInstance>&);
-    // The camera, for the bodies' level of detail: its position and the pixels a unit
+    // The camera, for the spheres' level of detail: its position and the pixels a unit
     // length spans at unit distance (projection[1][1] × height / 2).
     void setViewer(glm::vec3 eye, float pixelsPerUnit);
     // Uploads what changed; call once per frame before the passes run.
@@ -88,18 +77,15 @@ public:
     uint64_t version(SceneCategory single) const { return versions_[sceneCategoryIndex(single)]; }
 
 private:
-    enum MeshId {
-        kQuad, kLamp, kTumblerHigh, kTumblerMid, kTumblerLow, kSphereHigh, kSphereMid, kSphereLow, kParticle, kMeshCount
-    };
+    enum MeshId { kQuad, kLamp, kTumblerHigh, kTumblerLow, kSphereHigh, kSphereMid, kSphereLow, kParticle, kMeshCount };
     struct MeshRange { uint32_t firstIndex = 0, indexCount = 0, baseVertex = 0; };
     struct Group { MeshId mesh; SceneCategory category; Lod lod; bool anyLod; uint32_t first, count; };
 
     void buildMeshes(const SceneLook&);
     void rebuildGroups();
-    // Orders the tumblers (near → mid) and each sphere category's instances (near →
-    // mid → far) by their size on screen and keeps the counts in tumblerLevels_ and
-    // sphereLevels_.
-    void sortBodiesBySize();
+    // Orders each sphere category's instances near → mid → far by their size on
+    // screen and keeps the three counts in sphereLevels_.
+    void sortSpheresBySize();
     void noteContents(SceneCategory, const GpuInstance* begin, size_t count);
 
     std::array<MeshRange, kMeshCount> meshes_{};
@@ -112,8 +98,6 @@ private:
     glm::vec3 eye_{0.0f};
     float pixelsPerUnit_ = 0.0f;
     std::array<std::array<uint32_t, 3>, 2> sphereLevels_{};  // marbles, fireballs: near, mid, far
-    std::array<uint32_t, 2> tumblerLevels_{};                 // near, mid
-    float tumblerRadius_ = 0.2f;                              // the lower cap's (SceneLook::tumblerB)
     bool dirty_ = true;
     uint32_t counts_[kSceneGeometryCount] = {};
     uint64_t versions_[kSceneGeometryCount] = {};

@@ -68,11 +68,11 @@ TEST_CASE("a floor point in a tumbler's shadow is darker than its lit neighbour"
     const float* l = img.at(int(lit.x), int(lit.y));
     const float sLum = s[0] + s[1] + s[2], lLum = l[0] + l[1] + l[2];
     INFO("shadowed " << sLum << " at " << shadowed.x << "," << shadowed.y << "; lit " << lLum);
-    // In shadow only the indirect light remains: measured 0.52 against 1.01 lit with
-    // the default's two bounces and its voxels' faces (0.35 before the faces, when the
-    // floor shadowed itself: its indirect light was 0.82× the path tracer's, 0.89× now).
-    // 0.7 still fails a missing or misplaced shadow (ratio ≈ 1).
-    CHECK(sLum < 0.7f * lLum);
+    // In shadow only the indirect light remains: measured 0.39 against 1.01 lit with
+    // the default's two bounces and its voxels' faces (0.35 before the faces; the path
+    // tracer agrees the box is that bright). A factor 2 still fails a missing or
+    // misplaced shadow (ratio ≈ 1).
+    CHECK(sLum * 2.0f < lLum);
 }
 
 TEST_CASE("the shadow pass is skipped while no caster moves and runs when one does", "[scene][gl]") {
@@ -192,31 +192,6 @@ TEST_CASE("sphere level of detail: the silhouette stays within a pixel of the ci
     CHECK(worst < 1.0);
     CHECK(worst > 0.5);  // and the coarse meshes are really used near their limits
     CHECK(scene::sphereLevelFor(500.0f) == 0);
-}
-
-TEST_CASE("tumbler level of detail: the silhouette and the profile stay within a pixel up to a 400-px radius",
-          "[scene]") {
-    // Around the axis the polygon of n slices strays r·(1 − cos(π/n)) from the circle;
-    // along the profile, the lower cap (the larger, radius r: the one the level is chosen
-    // by) spans 90° + α = 110° in `stacks` chords, each straying r·(1 − cos(θ/2)).
-    // Computed here from the meshes' counts, not from the thresholds' comment.
-    const double capSpan = M_PI / 2 + scene::SceneLook{}.tumblerAlpha;
-    auto strayPx = [&](double r, int level) {
-        const double around = r * (1.0 - std::cos(M_PI / scene::kTumblerSlices[level]));
-        const double profile = r * (1.0 - std::cos(capSpan / scene::kTumblerStacks[level] / 2.0));
-        return std::max(around, profile);
-    };
-    double worst = 0;
-    for (double r = 1.0; r <= 400.0; r *= 1.01) {
-        const int level = scene::tumblerLevelFor(float(r));
-        REQUIRE(level >= 0);
-        REQUIRE(level <= 1);
-        worst = std::max(worst, strayPx(r, level));
-    }
-    INFO("worst stray " << worst << " px");
-    CHECK(worst < 1.0);
-    CHECK(worst > 0.5);                        // the coarse mesh is really used near its limit
-    CHECK(scene::tumblerLevelFor(40.0f) == 1);  // the default view's tumblers: the coarse mesh
 }
 
 TEST_CASE("composite shadow_filter pcss: the tumbler's shadow keeps its core and gets a wider edge than one lookup",
