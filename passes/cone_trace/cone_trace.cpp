@@ -37,6 +37,7 @@
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace {
@@ -138,6 +139,15 @@ public:
                        .doc = "trace_stride > 1: the traced samples"})
             .internal({.name = "planes", .format = Format::RGBA16F, .size = SizeRule::relativeOverParam("trace_stride"),
                        .doc = "trace_stride > 1: each sample's surface, xyz = normal, w = n·p (0,0,0 off geometry)"})
+            .internal({.name = "ages", .format = Format::RGBA32F, .size = SizeRule::relativeOverParam("trace_stride"),
+                       .doc = "reuse_frames > 1: x = frames each sample's light has been kept (0: traced this frame), "
+                              "yzw = the world point it was traced at"})
+            .internal({.name = "history", .format = Format::RGBA16F, .size = SizeRule::relativeOverParam("trace_stride"),
+                       .doc = "reuse_frames > 1: last frame's samples"})
+            .internal({.name = "history_planes", .format = Format::RGBA16F,
+                       .size = SizeRule::relativeOverParam("trace_stride"), .doc = "reuse_frames > 1: their surfaces"})
+            .internal({.name = "history_ages", .format = Format::RGBA32F,
+                       .size = SizeRule::relativeOverParam("trace_stride"), .doc = "reuse_frames > 1: their ages and points"})
             .param(intChoiceParam("cones", 6, {1, 5, 6, 9, 16},
                                   "diffuse cones per pixel, around the normal (with fixed_cones bound: 6, the fixed set)"))
             .param(floatParam("aperture", 60.0f, 5.0, 150.0, "cone opening angle, degrees"))
@@ -153,6 +163,13 @@ public:
             .param(intChoiceParam("output_divisor", 1, {1, 2},
                                   "2: upsample to half resolution; composite's bilinear lookup does the last 2×"))
             .param(floatParam("upsample_tolerance", 0.02f, 0.001, 1.0, "plane distance (world) that halves a sample's weight"))
+            .param(intParam("reuse_frames", 1, 1, 8,
+                            "trace_stride > output_divisor: a sample on the surface last frame's nearest sample had "
+                            "keeps its light for up to N − 1 frames, tiles of 8×8 samples retracing in turn (1: every "
+                            "sample traced every frame)"))
+            .param(floatParam("reuse_tolerance", 0.02f, 0.0001, 0.5,
+                              "reuse: how far (world) a sample may lie from where last frame's nearest sample was "
+                              "traced and still take its light"))
             .param(boolParam("lamp", false,
                              "alpha = the lamp's unshadowed projected solid angle at each traced surface (its "
                              "silhouette's contour, 16 vertices), upsampled with the indirect light, for composite's "
@@ -172,6 +189,7 @@ public:
         kiln::Defines defines = schedule(ctx, voxels.width);
         defines.emplace_back("KILN_LAMP_IN_ALPHA", ctx.getBool("lamp") ? "1" : "0");
         defines.emplace_back("KILN_LAMP_SAMPLES", "16");  // silhouette vertices: within 0.8 % (tests/gi/test_lamp.cpp)
+        defines.emplace_back("KILN_REUSE", "0");
         GLuint trace = ctx.program({.stages = {"common/fullscreen.vert", "cone_trace/cone_trace.frag"}, .defines = defines});
         GLuint upsample = ctx.program({.stages = {"common/fullscreen.vert", "cone_trace/upsample.frag"}});
         if (!trace || !upsample) return;
@@ -182,9 +200,19 @@ public:
         const int divisor = ctx.getInt("output_divisor");
         const bool upsampled = stride > divisor;
         const int traceStep = upsampled ? stride : divisor;
+        const int reuseFrames = upsampled ? ctx.getInt("reuse_frames") : 1;
+        const bool reuse = reuseFrames > 1;
 
-        if (!(upsampled ? ctx.framebuffer({"samples", "planes"}) : ctx.framebuffer({"indirect"}))) return;
+        if (reuse) {
+            defines.back() = {"KILN_REUSE", "1"};
+            trace = ctx.program({.stages = {"common/fullscreen.vert", "cone_trace/cone_trace.frag"}, .defines = defines});
+            if (!trace) return;
+        }
+        if (!(reuse ? ctx.framebuffer({"samples", "planes", "ages"})
+                    : upsampled ? ctx.framebuffer({"samples", "planes"}) : ctx.framebuffer({"indirect"})))
+            return;
         glUseProgram(trace);
+        if (reuse) bindHistory(ctx, trace, reuseFrames);
         kiln::gl::bindTexture(trace, "u_normal", ctx.input("normal").id);
         kiln::gl::bindTexture(trace, "u_depth", ctx.input("depth").id);
         kiln::gl::bindTexture(trace, "u_voxels", voxels.id);
@@ -201,6 +229,7 @@ public:
         glUniform1f(loc("u_voxelRes"), float(voxels.width));
         glUniform1i(loc("u_stride"), traceStep);
         ctx.drawFullscreenTriangle();
+        if (reuse) keepHistory(ctx);
 
         if (upsampled) {
             if (!ctx.framebuffer({"indirect"})) return;
@@ -215,6 +244,42 @@ public:
             ctx.drawFullscreenTriangle();
         }
     }
+
+private:
+    // Last frame's samples for the reuse variant. Everything retraces (every tile due)
+    // when what the kept light depends on changed everywhere at once, which the
+    // distance test cannot see: the lamp, the box or the dome (a scene reload), the
+    // program (a shader or parameter edit), the textures (a resize).
+    void bindHistory(kiln::PassContext& ctx, GLuint program, int reuseFrames) {
+        const kiln::SceneView& scene = ctx.scene();
+        uint64_t world = 0;
+        for (kiln::SceneCategory c : {kiln::kSceneLight, kiln::kSceneBox, kiln::kSceneLamp})
+            world = world * 1000003u + scene.versions[kiln::sceneCategoryIndex(c)];
+        const GLuint history = ctx.internal("history").id;
+        const bool fresh = world != world_ || program != program_ || history != history_;
+        world_ = world, program_ = program, history_ = history;
+        kiln::gl::bindTexture(program, "u_history", history);
+        kiln::gl::bindTexture(program, "u_historyPlanes", ctx.internal("history_planes").id);
+        kiln::gl::bindTexture(program, "u_historyAges", ctx.internal("history_ages").id);
+        glUniformMatrix4fv(glGetUniformLocation(program, "u_prevViewProj"), 1, GL_FALSE, &previousViewProj_[0][0]);
+        glUniform1i(glGetUniformLocation(program, "u_reuseFrames"), fresh ? 1 : reuseFrames);
+        glUniform1i(glGetUniformLocation(program, "u_frame"), frame_++ % reuseFrames);
+        glUniform1f(glGetUniformLocation(program, "u_reuseTolerance"), ctx.getFloat("reuse_tolerance"));
+        previousViewProj_ = scene.frame.viewProj;
+    }
+
+    // This frame's samples become the next frame's history.
+    static void keepHistory(kiln::PassContext& ctx) {
+        const kiln::TextureRef& samples = ctx.internal("samples");
+        for (auto [from, to] : {std::pair{"samples", "history"}, {"planes", "history_planes"}, {"ages", "history_ages"}})
+            glCopyImageSubData(ctx.internal(from).id, GL_TEXTURE_2D, 0, 0, 0, 0, ctx.internal(to).id, GL_TEXTURE_2D, 0, 0,
+                               0, 0, samples.width, samples.height, 1);
+    }
+
+    glm::mat4 previousViewProj_{1.0f};
+    uint64_t world_ = 0;
+    GLuint program_ = 0, history_ = 0;
+    int frame_ = 0;
 };
 
 }  // namespace
