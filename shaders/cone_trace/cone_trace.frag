@@ -62,7 +62,6 @@ void main() {
     }
     vec3 p = worldAtTexel(u_depth, src);
     vec3 n = normalize(n4.xyz);
-    bool trace = true;
 #if KILN_REUSE
     ivec2 h;
     bool same = reusable(p, n, h);
@@ -70,11 +69,13 @@ void main() {
     float age = kept.x;
     ivec2 tile = ivec2(gl_FragCoord.xy) / 8;
     bool due = (tile.x + 3 * tile.y + u_frame) % u_reuseFrames == 0;
-    trace = due || !same || age >= float(u_reuseFrames - 1);
+    bool trace = due || !same || age >= float(u_reuseFrames - 1);
     o_indirect = texelFetch(u_history, h, 0);
     o_age = vec4(age + 1.0, kept.yzw);
-#endif
     for (int k = trace ? 0 : 1; k < 1; ++k) {
+#else
+    {  // every sample traced (a loop around it, even a constant one, cost 2 ms at 720²)
+#endif
         o_indirect = traceDiffuse(p, n);
 #if KILN_LAMP_IN_ALPHA
         // The lamp's unshadowed irradiance ÷ its radiance (smooth on a surface, like the
