@@ -21,7 +21,8 @@
 // Fixed cones: bind voxel_mip.fixed_cones (mode fixed_cones) to `fixed_cones` instead
 // of `aniso`. The cones are then the same for every pixel: the 12 directions of an
 // icosahedron (shaders/common/fixed_cones.glsl), of which a surface traces the 6 (4 on
-// the box's axis-aligned walls) in its hemisphere, weighted by cos θ; `cones` must be 6. Each step is one fetch from chains voxel_mip blended per direction, not three:
+// the box's axis-aligned walls) in its hemisphere, weighted by cos θ; `cones` must be 6.
+// Each step is one fetch from chains voxel_mip blended per direction, not three:
 // the anisotropic result at the cost of an isotropic lookup.
 // trace_stride 2 or 4: trace one pixel in every 2×2 (4×4) block into the internal
 // `samples`, with the traced surface's plane in `planes`, then a depth/normal-aware
@@ -31,6 +32,12 @@
 // surfaces, so the error stays small where a traced sample lies on the pixel's own
 // surface (measured against full resolution in tests/gi and against the path-traced
 // reference by kiln-bench-quality); at silhouettes the nearest sample stands in.
+// reuse_frames N > 1 (strided traces): a sample within reuse_tolerance of where last
+// frame's nearest sample was traced, with its normal, keeps that sample's light (and
+// lamp) for up to N − 1 frames; tiles of 8×8 samples retrace in turn. The internal
+// `ages` holds each sample's age and traced point; `history*` are last frame's
+// samples, planes and ages (shaders/cone_trace/cone_trace.frag; README "Reusing traced
+// light" for its cost and its error on moving sequences).
 #include <kiln/pass.hpp>
 
 #include <algorithm>
