@@ -38,6 +38,7 @@
 // `ages` holds each sample's age and traced point; `history*` are last frame's
 // samples, planes and ages (shaders/cone_trace/cone_trace.frag; README "Reusing traced
 // light" for its cost and its error on moving sequences).
+#include <kiln/hash.hpp>
 #include <kiln/pass.hpp>
 
 #include <algorithm>
@@ -196,10 +197,6 @@ public:
         kiln::Defines defines = schedule(ctx, voxels.width);
         defines.emplace_back("KILN_LAMP_IN_ALPHA", ctx.getBool("lamp") ? "1" : "0");
         defines.emplace_back("KILN_LAMP_SAMPLES", "16");  // silhouette vertices: within 0.8 % (tests/gi/test_lamp.cpp)
-        defines.emplace_back("KILN_REUSE", "0");
-        GLuint trace = ctx.program({.stages = {"common/fullscreen.vert", "cone_trace/cone_trace.frag"}, .defines = defines});
-        GLuint upsample = ctx.program({.stages = {"common/fullscreen.vert", "cone_trace/upsample.frag"}});
-        if (!trace || !upsample) return;
         const int stride = ctx.getInt("trace_stride");
         // An `indirect` pixel covers `divisor` G-buffer texels per side. A trace no
         // sparser than that goes straight into it (one texel per pixel); a sparser one
@@ -209,12 +206,11 @@ public:
         const int traceStep = upsampled ? stride : divisor;
         const int reuseFrames = upsampled ? ctx.getInt("reuse_frames") : 1;
         const bool reuse = reuseFrames > 1;
+        defines.emplace_back("KILN_REUSE", reuse ? "1" : "0");
+        GLuint trace = ctx.program({.stages = {"common/fullscreen.vert", "cone_trace/cone_trace.frag"}, .defines = defines});
+        GLuint upsample = ctx.program({.stages = {"common/fullscreen.vert", "cone_trace/upsample.frag"}});
+        if (!trace || !upsample) return;
 
-        if (reuse) {
-            defines.back() = {"KILN_REUSE", "1"};
-            trace = ctx.program({.stages = {"common/fullscreen.vert", "cone_trace/cone_trace.frag"}, .defines = defines});
-            if (!trace) return;
-        }
         if (!(reuse ? ctx.framebuffer({"samples", "planes", "ages"})
                     : upsampled ? ctx.framebuffer({"samples", "planes"}) : ctx.framebuffer({"indirect"})))
             return;
@@ -259,9 +255,9 @@ private:
     // program (a shader or parameter edit), the textures (a resize).
     void bindHistory(kiln::PassContext& ctx, GLuint program, int reuseFrames) {
         const kiln::SceneView& scene = ctx.scene();
-        uint64_t world = 0;
+        uint64_t world = kiln::kFnvOffsetBasis;
         for (kiln::SceneCategory c : {kiln::kSceneLight, kiln::kSceneBox, kiln::kSceneLamp})
-            world = world * 1000003u + scene.versions[kiln::sceneCategoryIndex(c)];
+            world = kiln::fnv1a(&scene.versions[kiln::sceneCategoryIndex(c)], sizeof(uint64_t), world);
         const GLuint history = ctx.internal("history").id;
         const bool fresh = world != world_ || program != program_ || history != history_;
         world_ = world, program_ = program, history_ = history;

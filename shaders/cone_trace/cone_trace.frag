@@ -22,10 +22,10 @@ layout(location = 1) out vec4 o_plane;  // xyz = unit normal, w = n·p; 0 off ge
 // u_reuseTolerance of where last frame's nearest sample was traced, with a normal
 // within ~6° of its, keeps that sample's light for up to u_reuseFrames − 1 frames
 // (a distance, not a plane test: on a plane seen at a grazing angle, the nearest
-// sample on screen can be tens of centimetres away on it); tiles of 8×8 samples retrace in turn (one in u_reuseFrames
-// a frame), so a static surface's light is never older than that. Whole tiles skip the
-// trace together: llvmpipe leaves a loop once no lane needs it, but runs an `if` body
-// for every lane.
+// sample on screen can be tens of centimetres away on it); tiles of 8×8 samples
+// retrace in turn (one in u_reuseFrames a frame), so a static surface's light is never
+// older than that. Whole tiles skip the trace together: llvmpipe leaves a loop once no
+// lane needs it, but runs an `if` body for every lane.
 layout(binding = 7) uniform sampler2D u_history;        // last frame's samples
 layout(binding = 8) uniform sampler2D u_historyPlanes;  // their surfaces
 layout(binding = 9) uniform sampler2D u_historyAges;    // frames each had been kept, and where it was traced
@@ -35,8 +35,9 @@ uniform int u_frame;             // which tiles retrace this frame
 uniform float u_reuseTolerance;  // world units
 layout(location = 2) out vec4 o_age;  // x: frames this sample's light has been kept; yzw: the point traced
 
-// Last frame's sample nearest the point p, and whether its surface is p's.
-bool reusable(vec3 p, vec3 n, out ivec2 h) {
+// Last frame's sample nearest the point p (h, and its age and traced point in kept),
+// and whether its surface is p's.
+bool reusable(vec3 p, vec3 n, out ivec2 h, out vec4 kept) {
     vec4 clip = u_prevViewProj * vec4(p, 1.0);
     vec2 px = (clip.xy / max(clip.w, 1e-6) * 0.5 + 0.5) * u_outputSize.xy;  // last frame's pixel coordinates
     // Sample h traced texel stride·h + stride/2, centred at that + 0.5.
@@ -44,8 +45,8 @@ bool reusable(vec3 p, vec3 n, out ivec2 h) {
     ivec2 size = textureSize(u_history, 0);
     bool inside = clip.w > 0.0 && all(greaterThanEqual(h, ivec2(0))) && all(lessThan(h, size));
     h = clamp(h, ivec2(0), size - 1);
-    vec3 traced = texelFetch(u_historyAges, h, 0).yzw;
-    return inside && dot(texelFetch(u_historyPlanes, h, 0).xyz, n) > 0.995 && distance(traced, p) < u_reuseTolerance;
+    kept = texelFetch(u_historyAges, h, 0);
+    return inside && dot(texelFetch(u_historyPlanes, h, 0).xyz, n) > 0.995 && distance(kept.yzw, p) < u_reuseTolerance;
 }
 #endif
 
@@ -64,8 +65,8 @@ void main() {
     vec3 n = normalize(n4.xyz);
 #if KILN_REUSE
     ivec2 h;
-    bool same = reusable(p, n, h);
-    vec4 kept = texelFetch(u_historyAges, h, 0);
+    vec4 kept;
+    bool same = reusable(p, n, h, kept);
     float age = kept.x;
     ivec2 tile = ivec2(gl_FragCoord.xy) / 8;
     bool due = (tile.x + 3 * tile.y + u_frame) % u_reuseFrames == 0;
