@@ -36,6 +36,7 @@
 #include "app/app.hpp"
 #include <kiln/plot_script.hpp>
 #include "app/context.hpp"
+#include "kiln/gl.hpp"
 #include "kiln/log.hpp"
 #include "support/bench_support.hpp"
 
@@ -210,52 +211,43 @@ double emptyPassMs(int width, int height, int draws) {
         layout(location = 0) out vec4 o_color;
         void main() { o_color = vec4(gl_FragCoord.xy * 1e-3, 0.0, 1.0); })";
     auto stage = [](GLenum type, const char* source) {
-        const GLuint s = glCreateShader(type);
-        glShaderSource(s, 1, &source, nullptr);
-        glCompileShader(s);
-        return s;
+        gl::ShaderHandle shader(glCreateShader(type));
+        glShaderSource(shader.id(), 1, &source, nullptr);
+        glCompileShader(shader.id());
+        return shader;
     };
-    const GLuint vs = stage(GL_VERTEX_SHADER, kVertex), fs = stage(GL_FRAGMENT_SHADER, kFragment);
-    const GLuint program = glCreateProgram();
-    glAttachShader(program, vs);
-    glAttachShader(program, fs);
-    glLinkProgram(program);
-    glDeleteShader(vs);
-    glDeleteShader(fs);
+    const gl::ShaderHandle vs = stage(GL_VERTEX_SHADER, kVertex), fs = stage(GL_FRAGMENT_SHADER, kFragment);
+    const gl::ProgramHandle program(glCreateProgram());
+    glAttachShader(program.id(), vs.id());
+    glAttachShader(program.id(), fs.id());
+    glLinkProgram(program.id());
     GLint linked = 0;
-    glGetProgramiv(program, GL_LINK_STATUS, &linked);
-    GLuint texture = 0, framebuffer = 0, vao = 0;
-    glCreateTextures(GL_TEXTURE_2D, 1, &texture);
-    glTextureStorage2D(texture, 1, GL_RGBA16F, width, height);
-    glCreateFramebuffers(1, &framebuffer);
-    glNamedFramebufferTexture(framebuffer, GL_COLOR_ATTACHMENT0, texture, 0);
-    glCreateVertexArrays(1, &vao);
+    glGetProgramiv(program.id(), GL_LINK_STATUS, &linked);
+    if (!linked) return 0.0;
+    const gl::Texture target = gl::Texture::create(GL_TEXTURE_2D, GL_RGBA16F, width, height, 1, 1, "bench.floor");
+    const gl::FramebufferHandle framebuffer = gl::createFramebuffer();
+    glNamedFramebufferTexture(framebuffer.id(), GL_COLOR_ATTACHMENT0, target.id(), 0);
+    const gl::VertexArrayHandle vao = gl::createVertexArray();
+    glBindFramebuffer(GL_FRAMEBUFFER, framebuffer.id());
+    glViewport(0, 0, width, height);
+    glDisable(GL_DEPTH_TEST);
+    glUseProgram(program.id());
+    glBindVertexArray(vao.id());
+    // Wall time around each draw, with a glFinish on both sides: timestamp queries
+    // around this one draw (flushed or not) read 0.05 ms on llvmpipe, a fraction of
+    // it; a pass's queries bracket its framebuffer's whole scene.
     std::vector<double> ms;
-    if (linked) {
-        glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
-        glViewport(0, 0, width, height);
-        glDisable(GL_DEPTH_TEST);
-        glUseProgram(program);
-        glBindVertexArray(vao);
-        // Wall time around each draw, with a glFinish on both sides: timestamp queries
-        // around this one draw (flushed or not) read 0.05 ms on llvmpipe, a fraction of
-        // it; a pass's queries bracket its framebuffer's whole scene.
-        for (int i = 0; i < draws + 3; ++i) {
-            glFinish();
-            const auto t0 = std::chrono::steady_clock::now();
-            glDrawArrays(GL_TRIANGLES, 0, 3);
-            glFinish();
-            const auto t1 = std::chrono::steady_clock::now();
-            if (i >= 3) ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
-        }
-        glBindVertexArray(0);
-        glUseProgram(0);
-        glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    for (int i = 0; i < draws + 3; ++i) {
+        glFinish();
+        const auto t0 = std::chrono::steady_clock::now();
+        glDrawArrays(GL_TRIANGLES, 0, 3);
+        glFinish();
+        const auto t1 = std::chrono::steady_clock::now();
+        if (i >= 3) ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
     }
-    glDeleteVertexArrays(1, &vao);
-    glDeleteFramebuffers(1, &framebuffer);
-    glDeleteTextures(1, &texture);
-    glDeleteProgram(program);
+    glBindVertexArray(0);
+    glUseProgram(0);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
     return ms.empty() ? 0.0 : median(ms);
 }
 

@@ -165,9 +165,7 @@ TEST_CASE("kiln-bench-render --grow: one growth row per count, the first the bas
     CHECK(line == "config,pass,module,gpu_ms,cpu_ms,frame_ms,x_floor");
     int passRows = 0;
     while (std::getline(render, line)) {
-        std::vector<std::string> cells;
-        std::istringstream row(line);
-        for (std::string cell; std::getline(row, cell, ',');) cells.push_back(cell);
+        const std::vector<std::string> cells = csvCells(line);
         REQUIRE(cells.size() == 7);
         // The printed floor has two decimals; the CSV's multiple is of the unrounded one.
         CHECK(std::stod(cells[6]) == Approx(std::stod(cells[3]) / floorMs).epsilon(0.01 / floorMs + 1e-3));
