@@ -15,9 +15,9 @@
 //
 // Nothing bright: the bright-pass also raises a flag in a 4-byte buffer (an atomicOr
 // from each block with a texel above the threshold) that the blur's vertex shader
-// reads; with the flag down it draws nothing over the targets cleared to black. The flag never comes
-// back to the CPU: a read-back right after the dispatch would stall the CPU on the GPU
-// every frame.
+// reads; with the flag down it draws nothing over the targets cleared to black. The
+// flag never comes back to the CPU: a read-back right after the dispatch would stall
+// the CPU on the GPU every frame.
 #include <kiln/pass.hpp>
 
 #include <algorithm>
