@@ -506,7 +506,7 @@ TEST_CASE("voxel_mip: anisotropic levels composite front to back along their dir
     CHECK(d[3] == Approx(1.0f).margin(2e-3));
 }
 
-TEST_CASE("voxel_mip facing: a cone meets the floor from above, not from below; edge-on as the mode says",
+TEST_CASE("voxel_mip facing: a cone meets the floor from above, not from below, edge-on as the mode says",
           "[gi][mip]") {
     // The empty box voxelized (the floor: one lit layer at y = 0, normal +y), its first
     // directional level read at a cell over the floor's middle: the children y = 0
