@@ -118,6 +118,7 @@ SceneView App::buildView() {
     v.frame.woodDark = glm::vec4(look.woodDark, 0.0f);
     v.frame.tumblerShape = glm::vec4(look.tumblerB, look.tumblerT, look.tumblerAlpha,
                                      (look.tumblerB - look.tumblerT) / std::sin(look.tumblerAlpha));
+    v.frame.boxWalls = glm::uvec4(boxWallBits(look.closed), 0u, 0u, 0u);
 
     if (v.frame.viewProj != lastViewProj_) lastViewProj_ = v.frame.viewProj, ++cameraVersion_;
     for (int i = 0; i < kSceneGeometryCount; ++i) {

@@ -12,4 +12,5 @@ layout(std140, binding = 0) uniform KilnFrame {
     vec4 u_woodLight;    // the floor's wood (scene file box.floor_wood): rgb, w = rings per metre
     vec4 u_woodDark;     // rgb
     vec4 u_tumblerShape; // round cone: b, t, α (rad), y_t (upper centre above the lower)
+    uvec4 u_boxWalls;    // x: faces of [-1,1]³ with a wall, bit 2a: −axis a, 2a+1: +axis a
 };

@@ -10,6 +10,15 @@
 //
 // Needs: u_voxels (iso chain, level 0 = voxelize.radiance), u_aniso (the octant atlas)
 // or u_fixedCones (the tile strip), u_voxelRes (voxels per side at level 0).
+//
+// Past a face of the box, a lookup reads what the face holds: a wall (in the outermost
+// voxels) goes on as a wall, so a cone that reaches it stops there whatever its width;
+// an open face (the Cornell box's front) has nothing behind it. Clamping alone stretched
+// the open front's rims — the floor's, the ceiling's and the side walls' last voxels —
+// into a tunnel in front of the box: every cone that left by the front met it, and the
+// gathered light was 1.26× the path tracer's in a box of emitting walls (1.24× for the
+// lamp's first bounce; tests/gi/test_bounces.cpp).
+#include "common/frame.glsl"
 layout(binding = 2) uniform sampler3D u_voxels;
 layout(binding = 3) uniform sampler3D u_aniso;
 layout(binding = 6) uniform sampler3D u_fixedCones;
@@ -26,27 +35,41 @@ vec3 insideBlock(vec3 p01, float al) {
     return clamp(p01, vec3(0.5 / side), vec3(1.0 - 0.5 / side));
 }
 
+// The share of a lookup at p01 on a level of `side` texels that lies inside the box or
+// behind a wall: trilinear filtering with an empty border on the open faces.
+float insideBox(vec3 p01, float side) {
+    uint walls = u_boxWalls.x;
+    vec3 wallBelow = vec3(uvec3(walls, walls >> 2, walls >> 4) & 1u);
+    vec3 wallAbove = vec3(uvec3(walls >> 1, walls >> 3, walls >> 5) & 1u);
+    vec3 below = max(clamp(p01 * side + 0.5, 0.0, 1.0), wallBelow);
+    vec3 above = max(clamp(side - p01 * side + 0.5, 0.0, 1.0), wallAbove);
+    vec3 f = below * above;
+    return f.x * f.y * f.z;
+}
+
 // p01: position in [0,1]³; d: unit direction of travel; tile: its index in the fixed
 // set (KILN_HAS_FIXED_CONES only); lod: level in base voxels (0 = res, 1 = res/2, ...).
 // Uniform-per-step lod keeps the branches below coherent.
 vec4 sampleVoxels(vec3 p01, vec3 d, int tile, float lod) {
 #if KILN_HAS_ANISO || KILN_HAS_FIXED_CONES
     vec4 base = vec4(0.0);
-    if (lod < 1.0) base = textureLod(u_voxels, p01, 0.0);
+    if (lod < 1.0) base = textureLod(u_voxels, p01, 0.0) * insideBox(p01, u_voxelRes);
     if (lod <= 0.0) return base;
     float al = max(lod - 1.0, 0.0);  // atlas level
     vec3 q = insideBlock(p01, al);
+    float inside = insideBox(p01, max(0.5 * u_voxelRes / exp2(al), 1.0));
 #if KILN_HAS_FIXED_CONES
-    vec4 s = textureLod(u_fixedCones, vec3((float(tile) + q.x) / float(kFixedConeTiles), q.y, q.z), al);
+    vec4 s = textureLod(u_fixedCones, vec3((float(tile) + q.x) / float(kFixedConeTiles), q.y, q.z), al) * inside;
 #else
     vec3 neg = vec3(lessThan(d, vec3(0.0)));
     vec3 w = d * d;
     vec4 s = w.x * textureLod(u_aniso, (vec3(neg.x, 0.0, 0.0) + q) * 0.5, al)
            + w.y * textureLod(u_aniso, (vec3(neg.y, 1.0, 0.0) + q) * 0.5, al)
            + w.z * textureLod(u_aniso, (vec3(neg.z, 0.0, 1.0) + q) * 0.5, al);
+    s *= inside;
 #endif
     return lod < 1.0 ? mix(base, s, lod) : s;
 #else
-    return textureLod(u_voxels, p01, lod);
+    return textureLod(u_voxels, p01, lod) * insideBox(p01, max(u_voxelRes / exp2(lod), 1.0));
 #endif
 }

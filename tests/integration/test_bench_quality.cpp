@@ -201,12 +201,11 @@ TEST_CASE("the default pipeline is closer to the path-traced reference than the 
     // half-size image, and at 96² those 12×12 samples smear the lamp's light on the
     // ceiling (the mean light falls to 0.94×). 128 paths, not more: the render dominates
     // the suite's time, and the figures asserted are noise-corrected or means.
-    // Measured (noise-corrected relMSE): 0.0358 against 0.0509, the indirect part 0.0408
-    // against 0.110; the mean luminance 0.960× the reference's against 0.803× (issue
-    // 22: the course design's one bounce misses a fifth of the light, the default's two
-    // bounces all but the third and later ones, about 4 % here — its voxels no longer
-    // light and shadow themselves, which had stood in for them). SSIM is withheld at
-    // this path count (the halves disagree).
+    // Measured (noise-corrected relMSE): 0.0264 against 0.0581, the indirect part 0.0223
+    // against 0.129; the mean luminance 0.976× the reference's against 0.777× (issue
+    // 22: the course design's one bounce misses a fifth of the light, the default's
+    // three bounces all but the fourth and later ones, about 2.5 % here). SSIM is
+    // withheld at this path count (the halves disagree).
     const std::string out = std::string(TEST_OUTPUT_DIR) + "/bench-quality-default-vs-course";
     Run r = runProgram(KILN_BENCH_QUALITY,
                        "--size 128x128 --spp 128 --frames 1 --repeats 1 --sweep composite.exposure=1 "

@@ -144,8 +144,9 @@ namespace kiln {
 
 // Bump when anything in this header (or what it includes) changes layout or vtables,
 // or when what the host does for a pass changes (6: the host issues the barrier
-// between passes), so a module built for other terms is refused by name, not run.
-inline constexpr uint32_t kPassAbiVersion = 6;
+// between passes; 7: GpuFrame::boxWalls), so a module built for other terms is refused
+// by name, not run.
+inline constexpr uint32_t kPassAbiVersion = 7;
 
 struct TextureRef {
     GLuint id = 0;

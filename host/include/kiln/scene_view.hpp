@@ -46,7 +46,12 @@ struct GpuFrame {
     glm::vec4 woodDark;      //   rgb light / dark, woodLight.w = rings per metre
     glm::vec4 tumblerShape;  // the tumblers' round cone (kiln/sim/shape.hpp): lower radius
                              //   b, upper radius t, half-angle α (rad), upper centre y_t
+    glm::uvec4 boxWalls;     // x: the faces of the box [-1,1]³ that hold a wall, bit 2a for
+                             //   −axis a, 2a+1 for +axis a (the open Cornell box: all but +z)
 };
+
+// GpuFrame::boxWalls.x of a box with or without its front wall (z = +1).
+constexpr uint32_t boxWallBits(bool closed) { return closed ? 0x3Fu : 0x1Fu; }
 
 // The host camera's clip planes (GpuFrame::proj): what a pass that rasterises from the
 // camera declares as its depth output's depthNear/depthFar.
