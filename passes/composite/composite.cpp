@@ -45,14 +45,18 @@ public:
                              "distance (25 depth reads + 16 bilinear comparisons a pixel)"))
             .param(floatParam("indirect_strength", 1.0f, 0.0, 8.0, "scales the bound indirect irradiance (1 = physical)"))
             .param(floatParam("shadow_bias", 0.0005f, 0.0, 0.05, "depth bias of the shadow test"))
-            .param(enumParam("lamp_model", "contour", {"contour", "points", "traced"},
+            .param(enumParam("lamp_model", "contour", {"contour", "points", "traced", "field"},
                              "the lamp's irradiance: contour = its silhouette as a polygon (exact up to the "
                              "polygon, also next to the dome); points = a quadrature over the cap (lobes near it); "
                              "traced = the contour evaluated by cone_trace (its `lamp` on) where it traces, read "
-                             "from the indirect input's alpha"))
+                             "from the indirect input's alpha; field = n · the lamp's vector irradiance, from a "
+                             "grid of lamp_field_size³ built when the lamp changes (one lookup a pixel)"))
             .param(floatParam("lamp_near_field", 0.2f, 0.0, 4.0,
-                              "lamp_model traced: within this many metres of the dome the contour is evaluated per "
-                              "pixel (the irradiance changes faster there than the traced samples); 0 compiles that out"))
+                              "lamp_model traced or field: within this many metres of the dome the contour is "
+                              "evaluated per pixel (the irradiance changes faster there than the samples); 0 "
+                              "compiles that out"))
+            .param(intChoiceParam("lamp_field_size", 64, {16, 32, 64, 128},
+                                  "lamp_model field: grid nodes per side over the box"))
             .param(intChoiceParam("lamp_samples", 32, {4, 8, 16, 32, 64},
                                   "vertices of the lamp's silhouette (contour) or quadrature points over its cap (points)"));
         d.reads = kSceneLight | kSceneCamera | kSceneFireballs;
@@ -66,6 +70,7 @@ public:
                                 .defines = {{"KILN_LAMP_SAMPLES", std::to_string(ctx.getInt("lamp_samples"))},
                                             {"KILN_LAMP_CONTOUR", lampModel == "points" ? "0" : "1"},
                                             {"KILN_LAMP_TRACED", lampModel == "traced" ? "1" : "0"},
+                                            {"KILN_LAMP_FIELD", lampModel == "field" ? "1" : "0"},
                                             {"KILN_LAMP_NEAR_FIELD", nearField ? "1" : "0"},
                                             {"KILN_PCF", std::to_string(ctx.getInt("pcf"))},
                                             {"KILN_PCSS", ctx.getEnum("shadow_filter") == "pcss" ? "1" : "0"},
@@ -73,7 +78,8 @@ public:
         };
         GLuint program = variant(false);
         if (!program) return;
-        const bool nearField = lampModel == "traced" && ctx.getFloat("lamp_near_field") > 0.0f;
+        const bool nearField = (lampModel == "traced" || lampModel == "field") && ctx.getFloat("lamp_near_field") > 0.0f;
+        if (lampModel == "field" && !buildLampField(ctx)) return;
         GLuint nearProgram = nearField ? variant(true) : 0;
         if (nearField && !nearProgram) return;
         if (lampModel == "traced" && !ctx.isBound("indirect"))
@@ -117,6 +123,7 @@ private:
             kiln::gl::bindTexture(program, sampler, ctx.input(slot).id);
         kiln::gl::bindSamplerObject(program, "u_shadowMap", compareSampler_.id());
         kiln::gl::bindTexture(program, "u_shadowDepth", ctx.input("shadow_map").id);  // pcss only
+        kiln::gl::bindTexture(program, "u_lampField", lampField_.id());  // field only
         const std::string& tonemap = ctx.getEnum("tonemap");
         glUniform1f(glGetUniformLocation(program, "u_exposure"), ctx.getFloat("exposure"));
         glUniform1f(glGetUniformLocation(program, "u_ambient"), ctx.getFloat("ambient"));
@@ -129,6 +136,36 @@ private:
         glUniform1i(glGetUniformLocation(program, "u_fireballCount"), int(ctx.scene().count(kiln::kSceneFireballs)));
         ctx.drawFullscreenTriangle();
     }
+
+    // lamp_model field: the grid (the pass's own texture, made only in this mode: 2 MiB
+    // at 64³), rebuilt when the lamp, the grid's size or its shader changed. False when
+    // the pass failed.
+    bool buildLampField(kiln::PassContext& ctx) {
+        GLuint builder = ctx.program({.stages = {"composite/lamp_field.comp"},
+                                      .defines = {{"KILN_LAMP_SAMPLES", std::to_string(ctx.getInt("lamp_samples"))}}});
+        if (!builder) return false;
+        const int side = ctx.getInt("lamp_field_size");
+        if (!lampField_ || lampField_.width() != side)
+            lampField_ = kiln::gl::Texture::create(GL_TEXTURE_3D, GL_RGBA16F, side, side, side, 1, "composite.lamp_field");
+        const FieldKey key{ctx.scene().version(kiln::kSceneLight), side, builder};
+        if (key == builtField_) return true;
+        glUseProgram(builder);
+        kiln::gl::bindImage(builder, "u_field", lampField_.id(), 0, true, GL_WRITE_ONLY, GL_RGBA16F);
+        const GLuint groups = GLuint((side + 3) / 4);
+        glDispatchCompute(groups, groups, groups);
+        glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
+        builtField_ = key;
+        return true;
+    }
+
+    struct FieldKey {
+        uint64_t lightVersion = 0;
+        int side = 0;
+        GLuint program = 0;
+        bool operator==(const FieldKey&) const = default;
+    };
+    FieldKey builtField_;
+    kiln::gl::Texture lampField_;
 
     struct Rect {
         int x = 0, y = 0, width = 0, height = 0;

@@ -70,12 +70,15 @@ const float kCeilingY = 1.0;
 // θ/sin θ from the rational fit of Hill & Heitz's "Real-Time Area Lighting: a Journey
 // from Research to Production" (2016) instead of an atan and a division per edge (the fit
 // is of θ/(2π sin θ)).
-float lambertEdge(vec3 a, vec3 b, vec3 n) {
+// lambertEdgeVector: the same edge's term as a vector, θ · (a×b)/|a×b| (its n·… is
+// lambertEdge).
+vec3 lambertEdgeVector(vec3 a, vec3 b) {
     float x = dot(a, b), y = abs(x);
     float v = (0.8543985 + (0.4965155 + 0.0145206 * y) * y) / (3.4175940 + (4.1616724 + y) * y);
     float thetaOverSin = x > 0.0 ? v : 0.5 * inversesqrt(max(1.0 - x * x, 1e-7)) - v;
-    return dot(n, cross(a, b)) * thetaOverSin * 6.28318531;
+    return cross(a, b) * (thetaOverSin * 6.28318531);
 }
+float lambertEdge(vec3 a, vec3 b, vec3 n) { return dot(n, lambertEdgeVector(a, b)); }
 
 // The silhouette as a closed loop of vertices: the tangent arc (vertices 0 …
 // tangentCount − 1), then the rim arc's inner vertices.
@@ -122,20 +125,23 @@ vec3 nextOutlineVertex(LampOutline o, int i, inout OutlineWalk w) {
     return v;
 }
 
-// The emitter's projected solid angle Φ from p on a surface with normal n.
-float lampProjectedSolidAngle(vec3 p, vec3 n) {
+// The emitter's outline as seen from p (moved a hair below the ceiling when above it);
+// false when p sees nothing of it (inside the ball, or no emitter below the ceiling).
+// axis: the unit direction from p to the ball's centre.
+bool lampOutline(inout vec3 p, out LampOutline o, out vec3 axis) {
     const vec3 c = u_lightPos.xyz;
     const float radius = u_lightPos.w;
     const float rim2 = radius * radius - (c.y - kCeilingY) * (c.y - kCeilingY);
-    if (c.y - radius >= kCeilingY) return 0.0;  // nothing below the ceiling
-    p.y = min(p.y, kCeilingY - 1e-5);           // a ceiling point reconstructed a hair above it
+    o = LampOutline(vec3(0.0), vec3(0.0), vec3(0.0), 0.0, 0.0, 0.0, 0, vec3(0.0), 0.0, 0.0, 0.0, 0);
+    axis = vec3(0.0, 1.0, 0.0);
+    if (c.y - radius >= kCeilingY) return false;  // nothing below the ceiling
+    p.y = min(p.y, kCeilingY - 1e-5);             // a ceiling point reconstructed a hair above it
     vec3 toCentre = c - p;
     float d2 = dot(toCentre, toCentre);
-    if (d2 <= radius * radius * (1.0 + 1e-6)) return 0.0;  // inside the lamp
+    if (d2 <= radius * radius * (1.0 + 1e-6)) return false;  // inside the lamp
     float d = sqrt(d2);
-    vec3 axis = toCentre / d;
+    axis = toCentre / d;
 
-    LampOutline o;
     o.tangentCentre = c - (radius * radius / d) * axis;
     o.tangentRadius = radius * sqrt(1.0 - radius * radius / d2);
     // U: up, made perpendicular to the axis (V is then horizontal); any perpendicular
@@ -173,6 +179,35 @@ float lampProjectedSolidAngle(vec3 p, vec3 n) {
         bool viaTop = mod(thetaTop - thetaB, 6.28318531) < forward;
         o.thetaStart = thetaB, o.thetaSpan = viaTop ? forward : forward - 6.28318531;
     }
+    return true;
+}
+
+// The emitter's vector irradiance ÷ its radiance at p (Arvo 1995): F with Φ = n·F for
+// every normal n whose horizon leaves the whole emitter in front (n·F ≤ 0 when all of
+// it is behind; in between, clipping makes Φ ≥ max(n·F, 0)). Independent of n, smooth
+// in p: composite's lamp_model `field` stores it on a grid.
+vec3 lampVector(vec3 p) {
+    LampOutline o;
+    vec3 axis;
+    if (!lampOutline(p, o, axis)) return vec3(0.0);
+    const int count = KILN_LAMP_SAMPLES;
+    OutlineWalk walk = startArc(o.phiStart, o.phiSpan / float(o.rimCount > 0 ? o.tangentCount - 1 : o.tangentCount));
+    const vec3 first = normalize(nextOutlineVertex(o, 0, walk) - p);
+    vec3 previous = first, sum = vec3(0.0);
+    for (int i = 1; i <= count; ++i) {
+        vec3 current = i < count ? normalize(nextOutlineVertex(o, i, walk) - p) : first;
+        sum += lambertEdgeVector(previous, current);
+        previous = current;
+    }
+    return 0.5 * (dot(sum, axis) < 0.0 ? -sum : sum);
+}
+
+// The emitter's projected solid angle Φ from p on a surface with normal n.
+float lampProjectedSolidAngle(vec3 p, vec3 n) {
+    LampOutline o;
+    vec3 axis;
+    if (!lampOutline(p, o, axis)) return 0.0;
+    const int count = KILN_LAMP_SAMPLES;
 
     // Lambert's sum over the loop, clipped to the horizon n·ω ≥ 0. An edge with one end
     // below it is cut where it crosses (the crossing replaces that end). The region is

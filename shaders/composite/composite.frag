@@ -28,7 +28,10 @@ uniform float u_gamma;
 uniform int u_tonemap;   // kTonemapAces, kTonemapReinhard, kTonemapClamp
 uniform float u_shadowBias;
 uniform float u_indirectStrength;
-uniform float u_lampNearField;  // lamp_model traced: metres from the dome evaluated per pixel
+#if KILN_LAMP_FIELD
+layout(binding = 8) uniform sampler3D u_lampField;  // F at the grid's nodes (composite/lamp_field.comp)
+#endif
+uniform float u_lampNearField;  // lamp_model traced or field: metres from the dome evaluated per pixel
 
 #if KILN_PCSS && KILN_HAS_SHADOW_MAP
 // Metres along the lamp's view axis of a shadow-map depth in [0, 1].
@@ -119,13 +122,22 @@ void main() {
         vec3 albedo = texelFetch(u_albedo, px, 0).rgb;
         vec3 p = worldPosition(v_uv, texelFetch(u_depth, px, 0).r);
         vec3 n = normalize(n4.xyz);
-#if KILN_LAMP_TRACED
-        // cone_trace's `lamp`: the projected solid angle where it traced, upsampled. Within
-        // u_lampNearField of the dome it changes faster than those samples: evaluated
-        // here, by the variant composite.cpp draws over the near field's screen
-        // rectangle only (on llvmpipe the contour's mere presence in the shader cost
-        // every pixel of the frame, used or not).
+#if KILN_LAMP_TRACED || KILN_LAMP_FIELD
+        // traced: cone_trace's `lamp`, the projected solid angle where it traced,
+        // upsampled. field: n·F from the lamp's vector irradiance on a grid (exact up to
+        // the grid where the whole emitter is above the surface's horizon; where the
+        // horizon cuts it, n·F falls short of the clipped Φ — a grazing, dim band).
+        // Within u_lampNearField of the dome both change faster than their samples:
+        // evaluated here, by the variant composite.cpp draws over the near field's
+        // screen rectangle only (on llvmpipe the contour's mere presence in the shader
+        // cost every pixel of the frame, used or not).
+#if KILN_LAMP_FIELD
+        float fieldSide = float(textureSize(u_lampField, 0).x);
+        vec3 fieldCoord = (clamp(p, -1.0, 1.0) * 0.5 + 0.5) * ((fieldSide - 1.0) / fieldSide) + 0.5 / fieldSide;
+        float solidAngle = max(dot(n, textureLod(u_lampField, fieldCoord, 0.0).xyz), 0.0);
+#else
         float solidAngle = texture(u_indirect, v_uv).a;
+#endif
 #if KILN_LAMP_NEAR_FIELD
         if (distance(p, u_lightPos.xyz) < u_lightPos.w + u_lampNearField) solidAngle = lampProjectedSolidAngle(p, n);
 #endif

@@ -201,8 +201,8 @@ TEST_CASE("the default pipeline is closer to the path-traced reference than the 
     // half-size image, and at 96² those 12×12 samples smear the lamp's light on the
     // ceiling (the mean light falls to 0.94×). 128 paths, not more: the render dominates
     // the suite's time, and the figures asserted are noise-corrected or means.
-    // Measured (noise-corrected relMSE): 0.0264 against 0.0581, the indirect part 0.0223
-    // against 0.129; the mean luminance 0.976× the reference's against 0.777× (issue
+    // Measured (noise-corrected relMSE): 0.0168 against 0.0581, the indirect part 0.0223
+    // against 0.129; the mean luminance 0.967× the reference's against 0.777× (issue
     // 22: the course design's one bounce misses a fifth of the light, the default's
     // three bounces all but the fourth and later ones, about 2.5 % here). SSIM is
     // withheld at this path count (the halves disagree).
