@@ -55,8 +55,9 @@ public:
                               "lamp_model traced or field: within this many metres of the dome the contour is "
                               "evaluated per pixel (the irradiance changes faster there than the samples); 0 "
                               "compiles that out"))
-            .param(intChoiceParam("lamp_field_size", 64, {16, 32, 64, 128},
-                                  "lamp_model field: grid nodes per side over the box"))
+            .param(intChoiceParam("lamp_field_size", 128, {32, 64, 128},
+                                  "lamp_model field: grid nodes per side over the box (128: 1.6 cm apart, 16 MiB; "
+                                  "next to the dome as accurate as per-pixel contours)"))
             .param(intChoiceParam("lamp_samples", 32, {4, 8, 16, 32, 64},
                                   "vertices of the lamp's silhouette (contour) or quadrature points over its cap (points)"));
         d.reads = kSceneLight | kSceneCamera | kSceneFireballs;
@@ -137,8 +138,8 @@ private:
         ctx.drawFullscreenTriangle();
     }
 
-    // lamp_model field: the grid (the pass's own texture, made only in this mode: 2 MiB
-    // at 64³), rebuilt when the lamp, the grid's size or its shader changed. False when
+    // lamp_model field: the grid (the pass's own texture, made only in this mode: 16 MiB
+    // at 128³), rebuilt when the lamp, the grid's size or its shader changed. False when
     // the pass failed.
     bool buildLampField(kiln::PassContext& ctx) {
         GLuint builder = ctx.program({.stages = {"composite/lamp_field.comp"},
