@@ -1,6 +1,7 @@
 // composite — the final image: direct light from the lamp (the cap emitter of
-// shaders/common/light.glsl: its silhouette's contour integral, or `lamp_samples`
-// quadrature points) on the G-buffer (5×5 PCF
+// shaders/common/light.glsl: its silhouette's contour integral, `lamp_samples`
+// quadrature points, cone_trace's traced samples, or n · its vector irradiance from a
+// grid this pass builds when the lamp changes) on the G-buffer (PCF or PCSS
 // shadows from `shadow_map`), plus albedo × indirect irradiance (cone_trace), emission
 // and bloom; tonemap and gamma. Bloom is computed before this pass from the G-buffer's
 // emitted radiance (see passes/bloom), so no separate "lighting" pass is needed.

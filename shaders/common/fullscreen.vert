@@ -1,8 +1,9 @@
 #version 450 core
 // One triangle covering the screen (drawFullscreenTriangle: 3 vertices, no buffers).
+#include "fullscreen.glsl"
 out vec2 v_uv;
 void main() {
-    vec2 p = vec2((gl_VertexID << 1) & 2, gl_VertexID & 2);
+    vec2 p = fullscreenCorner();
     v_uv = p;
     gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
 }

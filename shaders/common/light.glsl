@@ -106,6 +106,12 @@ OutlineWalk startArc(float start, float step) {
     return OutlineWalk(vec2(cos(step), sin(step)), vec2(cos(start), sin(start)), grow, false);
 }
 
+// The walk from the outline's vertex 0, along the tangent arc (both its ends are
+// vertices when the rim closes it).
+OutlineWalk startOutline(LampOutline o) {
+    return startArc(o.phiStart, o.phiSpan / float(o.rimCount > 0 ? o.tangentCount - 1 : o.tangentCount));
+}
+
 // Vertex i (walked in order from 0) in world space; advances the walk.
 vec3 nextOutlineVertex(LampOutline o, int i, inout OutlineWalk w) {
     if (i == o.tangentCount) {  // onto the rim
@@ -191,7 +197,7 @@ vec3 lampVector(vec3 p) {
     vec3 axis;
     if (!lampOutline(p, o, axis)) return vec3(0.0);
     const int count = KILN_LAMP_SAMPLES;
-    OutlineWalk walk = startArc(o.phiStart, o.phiSpan / float(o.rimCount > 0 ? o.tangentCount - 1 : o.tangentCount));
+    OutlineWalk walk = startOutline(o);
     const vec3 first = normalize(nextOutlineVertex(o, 0, walk) - p);
     vec3 previous = first, sum = vec3(0.0);
     for (int i = 1; i <= count; ++i) {
@@ -215,7 +221,7 @@ float lampProjectedSolidAngle(vec3 p, vec3 n) {
     // along the horizon joins the exit to the entry. Branch-free (llvmpipe runs both
     // sides of a branch): one Lambert term per vertex; the last edge closes the loop on
     // the first vertex.
-    OutlineWalk walk = startArc(o.phiStart, o.phiSpan / float(o.rimCount > 0 ? o.tangentCount - 1 : o.tangentCount));
+    OutlineWalk walk = startOutline(o);
     const vec3 first = normalize(nextOutlineVertex(o, 0, walk) - p);
     const float dFirst = dot(n, first);
     vec3 previous = first;
