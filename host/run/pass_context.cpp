@@ -98,6 +98,12 @@ void HostPassContext::fail(std::string_view message) {
     slot_.error = std::string(message);
 }
 
+void HostPassContext::keepRunning(int frames, std::string_view reason) {
+    if (settling_) return;  // the frames a change started are not extended by themselves
+    slot_.settlingFrames = std::max(frames, 0);
+    slot_.settlingReason = std::string(reason);
+}
+
 const TextureRef& HostPassContext::texture(std::string_view name, bool internal) const {
     auto it = slot_.textures.find(name);
     if (it == slot_.textures.end() || it->second.internal != internal)

@@ -40,6 +40,9 @@ public:
                     const SceneView& view, const FrameInfo& frame)
         : shared_(shared), slot_(slot), planned_(planned), view_(view), frame_(frame) {}
 
+    // This run is one that an earlier keepRunning asked for (nothing else changed).
+    void markSettling() { settling_ = true; }
+
     const TextureRef& input(std::string_view slot) const override;
     bool isBound(std::string_view slot) const override;
     const TextureRef& output(std::string_view name) const override { return texture(name, false); }
@@ -55,6 +58,7 @@ public:
     void drawScene(const DrawFilter& filter) override { shared_.scene.draw(filter); }
     void nothingToDo(std::string_view reason) override { nothing_ = std::string(reason); }
     void fail(std::string_view message) override;
+    void keepRunning(int frames, std::string_view reason) override;
 
     bool failed() const { return failed_; }
     const std::optional<std::string>& nothing() const { return nothing_; }
@@ -71,6 +75,7 @@ private:
     const FrameInfo& frame_;
     // The accessors are const (a pass reads through them) but report misuse.
     mutable bool failed_ = false;
+    bool settling_ = false;
     std::optional<std::string> nothing_;
 };
 

@@ -27,6 +27,8 @@ struct PassSlot {
     std::map<std::string, gl::FramebufferHandle> framebuffers;
     ProgramCache programs;
     std::optional<std::vector<uint64_t>> lastRunKey;  // empty: run next frame
+    int settlingFrames = 0;                           // runs left that keepRunning asked for
+    std::string settlingReason;
     std::string error;                                // why the last execute failed
     std::string loggedError;                          // the last error printed (once each)
     PassTimings timings;

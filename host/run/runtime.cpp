@@ -319,15 +319,20 @@ void Runtime::runPass(size_t i, const FrameResources& shared, const SceneView& v
     if (slot.pass && slot.library && slot.library->faulted()) retireFaultedObject(slot);  // another pass of it faulted
     if (!slot.pass) return t.note("error", slot.error);
     const auto key = runKey(planned, slot, view);
-    if (!alwaysRun && !planned.decl.timeDependent && slot.lastRunKey == key && slot.error.empty()) {
+    const bool unchanged = !alwaysRun && !planned.decl.timeDependent && slot.lastRunKey == key && slot.error.empty();
+    const bool settling = unchanged && slot.settlingFrames > 0;
+    if (unchanged && !settling) {
         ++t.skippedFrames;
         return t.note("skipped", "inputs, parameters and scene unchanged");
     }
+    if (settling) --slot.settlingFrames;
+    else slot.settlingFrames = 0;  // a change: the pass says again whether it needs more frames
 
     resetGlState();
     shared.scene.bindInstances();
     slot.error.clear();
     HostPassContext ctx(shared, slot, planned, view, frame);
+    if (settling) ctx.markSettling();
     const auto cpuStart = std::chrono::steady_clock::now();
     std::optional<std::string> fault;
     {
@@ -363,7 +368,9 @@ void Runtime::runPass(size_t i, const FrameResources& shared, const SceneView& v
     ++t.ranFrames;
     slot.lastRunKey = runKey(planned, slot, view);
     if (ctx.nothing()) return t.note("nothing to do", *ctx.nothing());
-    t.note("ran", "");
+    t.note("ran", slot.settlingFrames > 0 ? str("settling (", slot.settlingReason, "): ", slot.settlingFrames,
+                                                 slot.settlingFrames == 1 ? " more frame" : " more frames")
+                                           : std::string());
     for (auto& [name, tex] : slot.textures) tex.version = ++versionCounter_;
 }
 

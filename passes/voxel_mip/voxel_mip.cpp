@@ -67,7 +67,15 @@ namespace {
 // diameter, with `facing`).
 constexpr float kGatherStartOffset = 1.0f;
 constexpr float kGatherDiameterOffset = 0.5f;
-kiln::Defines gatherDefines(kiln::PassContext& ctx, int res) {
+// A gather's three jobs (bounce.comp's KILN_BOUNCE_STEP).
+enum class BounceStep { GatherAndReflect = 0, GatherForNextFrame = 1, ReflectLastFrames = 2 };
+
+// With feedback every frame adds `bounces` bounces to what the voxels converge to; the
+// share of light still to come shrinks by about the surfaces' albedo a bounce (0.5 in
+// the white furnace, under that in the open box), so 16 frames leave < 0.5^16 of it.
+constexpr int kFeedbackSettleFrames = 16;
+
+kiln::Defines gatherDefines(kiln::PassContext& ctx, int res, BounceStep step) {
     const float voxel = 2.0f / float(res), tanHalf = std::tan(float(M_PI) / 6.0f), maxDistance = 2.0f;
     std::string list;
     int steps = 0;
@@ -80,7 +88,8 @@ kiln::Defines gatherDefines(kiln::PassContext& ctx, int res) {
         list += step;
     }
     const std::string& mode = ctx.getEnum("mode");
-    return {{"KILN_GATHER_BLOCK", std::to_string(ctx.getInt("gather_block"))},
+    return {{"KILN_BOUNCE_STEP", std::to_string(int(step))},
+            {"KILN_GATHER_BLOCK", std::to_string(ctx.getInt("gather_block"))},
             {"KILN_CONE_STEPS", std::to_string(steps)},
             {"KILN_CONE_SCHEDULE", list},
             {"KILN_HAS_ANISO", mode == "aniso" ? "1" : "0"},
@@ -111,12 +120,18 @@ public:
                      .producedWhen = {"mode", {"fixed_cones"}}})
             .internal({.name = "bounced", .kind = TextureKind::Color3D, .format = Format::RGBA16F, .size = cube,
                        .doc = "bounces > 1: level 0 with one more bounce, before it replaces iso's"})
+            .internal({.name = "feedback", .kind = TextureKind::Color3D, .format = Format::RGBA16F, .size = cube,
+                       .doc = "feedback: the light each voxel's block gathered last frame (mean incoming radiance)"})
             .param(enumParam("mode", "aniso", {"iso", "aniso", "fixed_cones"},
                              "iso: the isotropic chain only; aniso: the six directional chains too; "
                              "fixed_cones: those blended per fixed cone direction as well"))
             .param(intParam("bounces", 1, 1, 8,
                             "diffuse bounces the frame shows: 1 = the voxels hold direct light and emission (the "
                             "pixels gather one bounce); each more is gathered in the voxels first"))
+            .param(boolParam("feedback", false,
+                             "the voxels start each frame from the last frame's bounced light and gather once more "
+                             "for the next: every bounce once converged (`bounces` more a frame), a frame behind "
+                             "motion; needs `albedo` and `normal`"))
             .param(enumParam("facing", "off", {"off", "back", "back_and_edge"},
                              "directional chains (needs `normal`): back: a surface voxel a cone meets from "
                              "behind is empty (every cone leaves its own surface that way); back_and_edge: "
@@ -138,44 +153,80 @@ public:
         const kiln::TextureRef& in = ctx.input("radiance");
         const kiln::TextureRef& chain = ctx.output("iso");
         const int bounces = ctx.getInt("bounces");
-        if (bounces > 1 && !(ctx.isBound("albedo") && ctx.isBound("normal")))
-            return ctx.fail("bounces " + std::to_string(bounces) +
+        const bool feedback = ctx.getBool("feedback");
+        const bool gathers = bounces > 1 || feedback;
+        if (gathers && !(ctx.isBound("albedo") && ctx.isBound("normal")))
+            return ctx.fail(std::string(feedback ? "feedback" : "bounces " + std::to_string(bounces)) +
                             " needs `albedo` and `normal` bound (voxelize.albedo, voxelize.normal): what each voxel "
                             "reflects, and which way");
         if (ctx.getEnum("facing") != "off" && !ctx.isBound("normal"))
             return ctx.fail("facing needs `normal` bound (voxelize.normal): which way each voxel's surface faces");
-        GLuint bounce = bounces > 1 ? ctx.program({.stages = {"voxel_mip/bounce.comp"}, .defines = gatherDefines(ctx, chain.width)}) : 0;
-        if (bounces > 1 && !bounce) return;
         const int res = chain.width;  // = the input's (SizeRule::fromInput)
+        auto gatherProgram = [&](BounceStep step) {
+            return ctx.program({.stages = {"voxel_mip/bounce.comp"}, .defines = gatherDefines(ctx, res, step)});
+        };
+        const GLuint bounce = bounces > 1 ? gatherProgram(BounceStep::GatherAndReflect) : 0;
+        const GLuint keep = feedback ? gatherProgram(BounceStep::GatherForNextFrame) : 0;
+        const GLuint reflectKept = feedback ? gatherProgram(BounceStep::ReflectLastFrames) : 0;
+        if ((bounces > 1 && !bounce) || (feedback && !(keep && reflectKept))) return;
         glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
-        glCopyImageSubData(in.id, GL_TEXTURE_3D, 0, 0, 0, 0, chain.id, GL_TEXTURE_3D, 0, 0, 0, 0, res, res, res);
+
+        // Level 0: the input, or with feedback the input plus what its surfaces reflect
+        // of the last frame's gather (nothing on the first frame after the texture was
+        // made or feedback turned on).
+        const kiln::TextureRef& kept = ctx.internal("feedback");
+        if (feedback) {
+            if (keptId_ != kept.id || keptRes_ != kept.width) {  // a name can be reused for a new texture
+                clearAllLevels(kept);
+                keptId_ = kept.id;
+                keptRes_ = kept.width;
+            }
+            dispatchGather(ctx, reflectKept, chain.id, 0);
+        } else {
+            keptId_ = 0;  // turned back on later: starts from nothing
+            glCopyImageSubData(in.id, GL_TEXTURE_3D, 0, 0, 0, 0, chain.id, GL_TEXTURE_3D, 0, 0, 0, 0, res, res, res);
+        }
         buildChains(ctx, iso, aniso, blend);
 
         // Each further bounce: gather through the chains just built into `bounced`, make
         // it level 0, rebuild the chains from it.
         for (int b = 2; b <= bounces; ++b) {
             const kiln::TextureRef& bounced = ctx.internal("bounced");
-            glUseProgram(bounce);
-            glUniform1f(glGetUniformLocation(bounce, "u_voxelRes"), float(res));
-            glUniform1f(glGetUniformLocation(bounce, "u_startOffset"), ctx.getFloat("gather_start_offset"));
-            glUniform1f(glGetUniformLocation(bounce, "u_diameterOffset"), ctx.getFloat("gather_diameter_offset"));
-            kiln::gl::bindTexture(bounce, "u_emitted", in.id);
-            kiln::gl::bindTexture(bounce, "u_albedo", ctx.input("albedo").id);
-            kiln::gl::bindTexture(bounce, "u_normal", ctx.input("normal").id);
-            kiln::gl::bindTexture(bounce, "u_voxels", chain.id);
-            kiln::gl::bindTexture(bounce, "u_aniso", ctx.output("aniso").id);
-            kiln::gl::bindTexture(bounce, "u_fixedCones", ctx.output("fixed_cones").id);
-            kiln::gl::bindImage(bounce, "u_bounced", bounced.id, 0, true, GL_WRITE_ONLY, GL_RGBA16F);
-            const int blocks = res / ctx.getInt("gather_block");
-            glDispatchCompute(groups(blocks), groups(blocks), groups(blocks));
-            glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+            dispatchGather(ctx, bounce, bounced.id, chain.id);
             glCopyImageSubData(bounced.id, GL_TEXTURE_3D, 0, 0, 0, 0, chain.id, GL_TEXTURE_3D, 0, 0, 0, 0, res, res, res);
             buildChains(ctx, iso, aniso, blend);
+        }
+        if (feedback) {
+            dispatchGather(ctx, keep, kept.id, chain.id);
+            ctx.keepRunning(kFeedbackSettleFrames, "voxel bounces fed back");
         }
     }
 
 private:
     static GLuint groups(int n) { return GLuint((n + 3) / 4); }
+
+    // One bounce.comp dispatch over the voxels' blocks, writing `target`'s level 0;
+    // `chainsRead` (iso) and the other chains are what its cones trace, if it gathers.
+    void dispatchGather(kiln::PassContext& ctx, GLuint program, GLuint target, GLuint chainsRead) {
+        const int res = ctx.output("iso").width;
+        glUseProgram(program);
+        glUniform1f(glGetUniformLocation(program, "u_voxelRes"), float(res));
+        glUniform1f(glGetUniformLocation(program, "u_startOffset"), ctx.getFloat("gather_start_offset"));
+        glUniform1f(glGetUniformLocation(program, "u_diameterOffset"), ctx.getFloat("gather_diameter_offset"));
+        kiln::gl::bindTexture(program, "u_emitted", ctx.input("radiance").id);
+        kiln::gl::bindTexture(program, "u_albedo", ctx.input("albedo").id);
+        kiln::gl::bindTexture(program, "u_normal", ctx.input("normal").id);
+        kiln::gl::bindTexture(program, "u_gathered", ctx.internal("feedback").id);
+        if (chainsRead) {
+            kiln::gl::bindTexture(program, "u_voxels", chainsRead);
+            kiln::gl::bindTexture(program, "u_aniso", ctx.output("aniso").id);
+            kiln::gl::bindTexture(program, "u_fixedCones", ctx.output("fixed_cones").id);
+        }
+        kiln::gl::bindImage(program, "u_bounced", target, 0, true, GL_WRITE_ONLY, GL_RGBA16F);
+        const int blocks = res / ctx.getInt("gather_block");
+        glDispatchCompute(groups(blocks), groups(blocks), groups(blocks));
+        glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+    }
 
     // Every chain the mode builds, from iso's level 0.
     void buildChains(kiln::PassContext& ctx, GLuint iso, GLuint aniso, GLuint blend) {
@@ -240,6 +291,8 @@ private:
         for (int l = 0; l < t.levels; ++l) glClearTexImage(t.id, l, GL_RGBA, GL_FLOAT, nullptr);
     }
 
+    GLuint keptId_ = 0;          // the feedback texture cleared last: another (or 0) means start over
+    int keptRes_ = 0;
     bool atlasCleared_ = false;  // cache flags only
     bool fixedCleared_ = false;
 };

@@ -12,6 +12,9 @@
 // and the whole sphere (|m| = 0: surfaces facing every way, e.g. a ball in the block):
 //     w(d) = |m| · max(m̂·d, 0) + (1 − |m|) / 4
 // (1/4: the mean of max(n·d, 0) over the sphere), normalised over the cones traced.
+// KILN_BOUNCE_STEP: 0 = gather and reflect (the above, into u_bounced); with feedback
+// (voxel_mip's `feedback`), 1 = gather only, kept as Ē per voxel for the next frame, and
+// 2 = no gather: L = L_0 + albedo · (that kept Ē), the frame's starting level 0.
 // fixed_cones.glsl first: trace.glsl's voxels.glsl includes it only inside
 // `#if KILN_HAS_FIXED_CONES`, and a file is included once per stage.
 #include "common/fixed_cones.glsl"
@@ -21,6 +24,7 @@ layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
 layout(binding = 0) uniform sampler3D u_emitted;  // voxelize.radiance: direct light + emission
 layout(binding = 1) uniform sampler3D u_albedo;   // voxelize.albedo
 layout(binding = 4) uniform sampler3D u_normal;   // voxelize.normal
+layout(binding = 5) uniform sampler3D u_gathered;  // KILN_BOUNCE_STEP 2: the last frame's step 1
 layout(rgba16f, binding = 0) uniform writeonly image3D u_bounced;
 
 const int kBlock = KILN_GATHER_BLOCK;
@@ -33,10 +37,8 @@ ivec3 voxelOf(ivec3 block, int i) { return block * kBlock + ivec3(i % kBlock, (i
 // The weight of cone direction d for surfaces of mean normal direction n and |m| = facing.
 float coneWeight(vec3 n, float facing, vec3 d) { return facing * max(dot(n, d), 0.0) + (1.0 - facing) * 0.25; }
 
-void main() {
-    ivec3 block = ivec3(gl_GlobalInvocationID);
-    int res = int(u_voxelRes);
-    if (any(greaterThanEqual(block * kBlock, ivec3(res)))) return;
+// The light gathered at block's surfaces (mean incoming radiance, Ē = E/π).
+vec3 gatherBlock(ivec3 block) {
     // The block's surfaces: their mean normal, and where they are.
     vec3 normalSum = vec3(0.0), centreSum = vec3(0.0);
     float surfaces = 0.0;
@@ -47,37 +49,58 @@ void main() {
         centreSum += (vec3(v) + 0.5) / u_voxelRes * 2.0 - 1.0;
         surfaces += 1.0;
     }
-    vec3 gathered = vec3(0.0);
-    if (surfaces > 0.0) {
-        vec3 m = normalSum / surfaces;
-        float facing = min(length(m), 1.0);
-        vec3 n = facing > 1e-3 ? normalize(m) : vec3(0.0, 1.0, 0.0);
-        vec3 centre = centreSum / surfaces;
-        // The cones to trace as a bit mask, walked with findLSB: llvmpipe runs an `if`
-        // body for every lane but leaves a loop once no lane has work (a wall's blocks
-        // trace 4 cones, not 12).
-        uint cones = 0u;
-        for (int t = 0; t < kFixedConeTiles; ++t)
-            if (coneWeight(n, facing, fixedConeDirection(t)) >= 1e-3) cones |= 1u << t;
-        vec3 sum = vec3(0.0);
-        float weights = 0.0;
-        for (; cones != 0u; cones &= cones - 1u) {
-            int t = findLSB(cones);
-            vec3 d = fixedConeDirection(t);
-            float w = coneWeight(n, facing, d);
-            // Off the surfaces: along their normal, or along the cone where they face
-            // every way.
-            vec3 away = facing >= 0.5 ? n : d;
-            sum += w * traceCone(centre + away * (u_startOffset * 2.0 / u_voxelRes), away, d, t).rgb;
-            weights += w;
-        }
-        gathered = sum / max(weights, 1e-6);
+    if (surfaces == 0.0) return vec3(0.0);
+    vec3 m = normalSum / surfaces;
+    float facing = min(length(m), 1.0);
+    vec3 n = facing > 1e-3 ? normalize(m) : vec3(0.0, 1.0, 0.0);
+    vec3 centre = centreSum / surfaces;
+    // The cones to trace as a bit mask, walked with findLSB: llvmpipe runs an `if`
+    // body for every lane but leaves a loop once no lane has work (a wall's blocks
+    // trace 4 cones, not 12).
+    uint cones = 0u;
+    for (int t = 0; t < kFixedConeTiles; ++t)
+        if (coneWeight(n, facing, fixedConeDirection(t)) >= 1e-3) cones |= 1u << t;
+    vec3 sum = vec3(0.0);
+    float weights = 0.0;
+    for (; cones != 0u; cones &= cones - 1u) {
+        int t = findLSB(cones);
+        vec3 d = fixedConeDirection(t);
+        float w = coneWeight(n, facing, d);
+        // Off the surfaces: along their normal, or along the cone where they face
+        // every way.
+        vec3 away = facing >= 0.5 ? n : d;
+        sum += w * traceCone(centre + away * (u_startOffset * 2.0 / u_voxelRes), away, d, t).rgb;
+        weights += w;
     }
+    return sum / max(weights, 1e-6);
+}
+
+void main() {
+    ivec3 block = ivec3(gl_GlobalInvocationID);
+    int res = int(u_voxelRes);
+    if (any(greaterThanEqual(block * kBlock, ivec3(res)))) return;
+#if KILN_BOUNCE_STEP == 2
+    // Apply the last frame's gather (feedback): what each surface voxel reflects of it.
     for (int i = 0; i < kBlock * kBlock * kBlock; ++i) {
         ivec3 v = voxelOf(block, i);
         vec4 radiance = texelFetch(u_emitted, v, 0);
         vec3 albedo = texelFetch(u_albedo, v, 0).rgb;
-        if (reflects(radiance, albedo)) radiance.rgb += albedo * gathered * radiance.a;
+        if (reflects(radiance, albedo)) radiance.rgb += albedo * texelFetch(u_gathered, v, 0).rgb * radiance.a;
         imageStore(u_bounced, v, radiance);
     }
+#else
+    vec3 gathered = gatherBlock(block);
+    for (int i = 0; i < kBlock * kBlock * kBlock; ++i) {
+        ivec3 v = voxelOf(block, i);
+#if KILN_BOUNCE_STEP == 1
+        // Kept for the next frame (feedback): the gather itself, reflected there.
+        imageStore(u_bounced, v, vec4(gathered, 1.0));
+#else
+        vec4 radiance = texelFetch(u_emitted, v, 0);
+        vec3 albedo = texelFetch(u_albedo, v, 0).rgb;
+        if (reflects(radiance, albedo)) radiance.rgb += albedo * gathered * radiance.a;
+        imageStore(u_bounced, v, radiance);
+#endif
+    }
+#endif
 }

@@ -71,6 +71,10 @@
 //   contents and the skip ripples down the graph. Inside execute(),
 //   ctx.nothingToDo("why") says the scene holds nothing for you: your outputs keep
 //   their contents and versions, and the debug view shows the reason.
+//   ctx.keepRunning(n, "why") says your outputs go on changing with nothing changed
+//   upstream (feedback that converges over frames): the host runs you n more frames
+//   after this run even if nothing changes. A call from one of those frames does not
+//   extend them, so a paused frame settles and then costs nothing again.
 //
 // EXECUTING
 //   ctx.input/output/internal("name") give a TextureRef (GL name + shape); asking for
@@ -144,9 +148,9 @@ namespace kiln {
 
 // Bump when anything in this header (or what it includes) changes layout or vtables,
 // or when what the host does for a pass changes (6: the host issues the barrier
-// between passes; 7: GpuFrame::boxWalls), so a module built for other terms is refused
+// between passes; 7: GpuFrame::boxWalls; 8: PassContext::keepRunning), so a module built for other terms is refused
 // by name, not run.
-inline constexpr uint32_t kPassAbiVersion = 7;
+inline constexpr uint32_t kPassAbiVersion = 8;
 
 struct TextureRef {
     GLuint id = 0;
@@ -180,6 +184,7 @@ public:
     virtual void drawScene(const DrawFilter& filter) = 0;
     virtual void nothingToDo(std::string_view reason) = 0;
     virtual void fail(std::string_view message) = 0;
+    virtual void keepRunning(int frames, std::string_view reason) = 0;
 
     float getFloat(std::string_view n) const { return std::get<float>(param(n)); }
     int getInt(std::string_view n) const { return std::get<int>(param(n)); }
