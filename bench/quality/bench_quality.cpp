@@ -410,6 +410,8 @@ bool writeImages(const Args& args, const std::string& label, const FloatImage& i
     return true;
 }
 
+bool score(app::App& app, const Args& args, const std::string& label, const Reference& ref, Result& r);
+
 bool measure(app::App& app, const Args& args, const Setting& setting, const Reference& ref, Result& r) {
     std::string text, error;
     const std::string& pipeline = setting.pipeline.empty() ? args.pipeline : setting.pipeline;
@@ -418,14 +420,23 @@ bool measure(app::App& app, const Args& args, const Setting& setting, const Refe
         return fail(setting.label + ": " + error);
     app.runtime().setRequested({"composite.hdr", "gbuffer.emissive", "gbuffer.depth"});
     app.runtime().alwaysRun = true;
-    for (int f = 0; f < 2; ++f) app.frame();  // compile, allocate
+    // Compile, allocate, and let what converges over frames settle (voxel_mip's feedback
+    // asks 16 frames after a change; the previous setting's state is then forgotten).
+    for (int f = 0; f < 18; ++f) app.frame();
     glFinish();
     app.runtime().resetTimings();
     for (int f = 0; f < args.frames; ++f) app.frame();
     glFinish();
+    return score(app, args, setting.label, ref, r);
+}
+
+// The errors of the frame the pipeline just rendered, and the GPU times of the frames
+// since the last resetTimings.
+bool score(app::App& app, const Args& args, const std::string& label, const Reference& ref, Result& r) {
+    std::string error;
     app.runtime().collectGpuTimes();
-    for (auto& errorText : app.runtime().activeErrors()) return fail(setting.label + ": " + errorText);
-    r.label = setting.label;
+    for (auto& errorText : app.runtime().activeErrors()) return fail(label + ": " + errorText);
+    r.label = label;
     for (auto& row : app.runtime().stats()) {
         if (row.ranFrames == 0) continue;
         r.passMs.emplace_back(row.id, row.gpuMedianMs);
@@ -433,7 +444,7 @@ bool measure(app::App& app, const Args& args, const Setting& setting, const Refe
     }
     const TextureRef* hdr = app.runtime().findTexture("composite", "hdr");
     const TextureRef* emissive = app.runtime().findTexture("gbuffer", "emissive");
-    if (!hdr || !emissive) return fail(setting.label + ": the pipeline has no composite.hdr / gbuffer.emissive");
+    if (!hdr || !emissive) return fail(label + ": the pipeline has no composite.hdr / gbuffer.emissive");
     const FloatImage image = readTexture(hdr->id, hdr->target, hdr->format, hdr->width, hdr->height);
     const metrics::Mask mask =
         emittersMasked(readTexture(emissive->id, emissive->target, emissive->format, emissive->width, emissive->height));
@@ -443,7 +454,7 @@ bool measure(app::App& app, const Args& args, const Setting& setting, const Refe
     r.relMseCorrected = metrics::noiseCorrectedRelativeMse(image, halfA, halfB, mask);
 
     const TextureRef* depth = app.runtime().findTexture("gbuffer", "depth");
-    if (!depth) return fail(setting.label + ": the pipeline has no gbuffer.depth");
+    if (!depth) return fail(label + ": the pipeline has no gbuffer.depth");
     metrics::Mask ring;
     const std::vector<int> region =
         regionsOf(app, readTexture(depth->id, depth->target, depth->format, depth->width, depth->height), ring);
@@ -457,18 +468,53 @@ bool measure(app::App& app, const Args& args, const Setting& setting, const Refe
     }
     for (int p = 0; p < kPartCount; ++p) r.meanRatio[p] = metrics::meanLuminanceRatio(image, halfA, halfB, partMask[p]);
     // The indirect part: the same frame without composite's indirect term.
-    if (!app.runtime().setParam("composite", "indirect_strength", 0.0f, error)) return fail(setting.label + ": " + error);
+    if (!app.runtime().setParam("composite", "indirect_strength", 0.0f, error)) return fail(label + ": " + error);
     app.frame();
     glFinish();
     const FloatImage indirect =
         metrics::difference(image, readTexture(hdr->id, hdr->target, hdr->format, hdr->width, hdr->height));
     indirectFigures(indirect, ref, mask, partMask, r);
-    if (args.images && !writeImages(args, setting.label, image, indirect)) return false;
+    if (args.images && !writeImages(args, label, image, indirect)) return false;
     r.counted = mask;
     // The ratios may be NaN (a region out of view): they are printed as n/a, not checked.
     for (double v : {r.errors.rmse, r.errors.relMse, r.errors.ssim, r.relMseCorrected, r.indirectRelMse, r.indirectRelMseCorrected})
-        if (!std::isfinite(v)) return fail(setting.label + ": an error metric is not finite");
+        if (!std::isfinite(v)) return fail(label + ": an error metric is not finite");
     return true;
+}
+
+// The default pipeline while the scene moves: the simulation restarted and stepped to
+// --time with the pipeline rendering every step as the window does (passes skip what
+// did not change; feedback is as many frames behind as it is in use), the frame at
+// --time scored against the same reference. A frozen frame cannot show what lags
+// behind motion; this row can. GPU times: the last --frames frames before --time.
+// False (said on stderr) when it fails or the simulation does not reach the state
+// the reference was rendered from.
+bool measureMoving(app::App& app, const Args& args, const Reference& ref, Result& r) {
+    const uint64_t frozenState = app.scene().sim().stateHash();
+    std::string text = slurp(args.pipeline), error;
+    if (!app.runtime().loadPipelineText(text, args.pipeline, error)) return fail(args.pipeline + ": " + error);
+    app.runtime().setRequested({"composite.hdr", "gbuffer.emissive", "gbuffer.depth"});
+    app.runtime().alwaysRun = false;
+    app.scene().reset();
+    app.paused = false;
+    app.frame();
+    const double dt = app.scene().time();
+    bool timing = false;
+    while (app.scene().time() + 1e-9 < args.time) {
+        if (!timing && app.scene().time() + dt * args.frames + 1e-9 >= args.time) {
+            glFinish();
+            app.runtime().resetTimings();
+            timing = true;
+        }
+        app.frame();
+    }
+    glFinish();
+    app.paused = true;
+    if (app.scene().sim().stateHash() != frozenState)
+        return fail("the moving run reached t = " + std::to_string(app.scene().time()) +
+                    " in another state than the frozen frame's (is the simulation deterministic?)");
+    const std::string label = fs::path(args.pipeline).stem().string() + " (moving)";
+    return score(app, args, label, ref, r);
 }
 
 void markPareto(std::vector<Result>& results) {
@@ -677,6 +723,11 @@ int main(int argc, char** argv) {
     if (args.images && (!writeImages(args, "reference", ref.mean, ref.meanIndirect))) return 1;
     std::vector<Result> results;
     if (!measureAll(app, args, settings, ref, results)) return 1;
+    if (args.time > 0) {  // at t = 0 nothing has moved yet
+        Result moving;
+        if (!measureMoving(app, args, ref, moving)) return 1;
+        results.push_back(std::move(moving));
+    }
     const ReferenceFigures figures = referenceFigures(ref, args, results.front().counted);
 
     fs::create_directories(args.outDir);

@@ -153,6 +153,15 @@ int App::stepRealTime(double wallSeconds, std::chrono::steady_clock::time_point 
     return steps;
 }
 
+int App::settle(int maxFrames) {
+    const bool wasPaused = paused;
+    paused = true;
+    int frames = 0;
+    for (; frames < maxFrames && runtime_.settling(); ++frames) frame();
+    paused = wasPaused;
+    return frames;
+}
+
 void App::frame(double wallSeconds) {
     live_.poll(*this);  // edits land at a frame boundary, on this thread
     if (viewed != requestedView_) {

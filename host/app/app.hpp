@@ -31,6 +31,10 @@ public:
     // time at 14 fps in a quarter of a millisecond); beyond it the backlog is dropped,
     // so a slow frame never stalls on steps it cannot catch up with.
     void frame(double wallSeconds = -1.0);
+    // Frames with the simulation held until no pass is settling (feedback converging
+    // over frames, kiln/pass.hpp keepRunning), at most maxFrames; the frames it ran.
+    // For an output written from one moment (--out, a test's read-back).
+    int settle(int maxFrames = 64);
     double stepBudgetMs = 10.0;
     double timeScale = 1.0;
     int lastSteps = 0;          // steps taken in the last frame

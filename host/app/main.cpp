@@ -78,6 +78,9 @@ int runHeadless(const Options& o) {
 
     app.runtime().alwaysRun = o.noSkip;
     for (int f = 0; f < o.frames; ++f) app.frame();
+    // The outputs show the last frame's moment converged, not part way (voxel bounces
+    // fed back gain one a frame).
+    if (const int settled = app.settle()) log::info("settled in ", settled, settled == 1 ? " frame" : " frames");
     app.runtime().collectGpuTimes();
     if (!writeOutputs(app, o, error)) return fail(error);
     if (o.stats) std::printf("%s", app.runtime().statsTable().c_str());

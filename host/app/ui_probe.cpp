@@ -33,6 +33,7 @@ nlohmann::json probeState(const WindowState& state, uint64_t frame) {
     j["sim_time"] = app.scene().time();           // seconds simulated
     j["sim_dropped_s"] = app.droppedSeconds;      // simulated seconds given up to the step budget
     j["render_scale"] = state.renderScale;
+    j["settling"] = app.runtime().settling();     // a pass's output still converging (keepRunning)
     j["errors"] = app.runtime().activeErrors();
     j["editor_error"] = state.editor.error;
     j["texture_filter"] = std::string(state.textureFilter.InputBuf);

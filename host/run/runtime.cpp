@@ -319,9 +319,9 @@ void Runtime::runPass(size_t i, const FrameResources& shared, const SceneView& v
     if (slot.pass && slot.library && slot.library->faulted()) retireFaultedObject(slot);  // another pass of it faulted
     if (!slot.pass) return t.note("error", slot.error);
     const auto key = runKey(planned, slot, view);
-    const bool unchanged = !alwaysRun && !planned.decl.timeDependent && slot.lastRunKey == key && slot.error.empty();
-    const bool settling = unchanged && slot.settlingFrames > 0;
-    if (unchanged && !settling) {
+    const bool unchanged = !planned.decl.timeDependent && slot.lastRunKey == key && slot.error.empty();
+    const bool settling = unchanged && slot.settlingFrames > 0;  // counted under alwaysRun too
+    if (unchanged && !settling && !alwaysRun) {
         ++t.skippedFrames;
         return t.note("skipped", "inputs, parameters and scene unchanged");
     }
@@ -475,6 +475,10 @@ std::optional<NamedTexture> Runtime::namedTexture(std::string_view qualified) co
         return NamedTexture{s->id, it->first, t.internal, t.ref, t.decl.depthNear, t.decl.depthFar, t.decl.size.tiles};
     }
     return std::nullopt;
+}
+
+bool Runtime::settling() const {
+    return std::any_of(slots_.begin(), slots_.end(), [](const auto& slot) { return slot->settlingFrames > 0; });
 }
 
 std::vector<PassRow> Runtime::stats() const {

@@ -70,6 +70,9 @@ public:
     void resetTimings();
     // Runs every pass every frame regardless of versions (timing runs).
     bool alwaysRun = false;
+    // A pass has frames left that it asked for with keepRunning (its output is still
+    // converging with nothing changed upstream).
+    bool settling() const;
     // The CPU cost of the last renderFrame: all of it, and the part inside the passes'
     // execute(); the rest is the graph's own (version checks, state resets, timer
     // queries, uniform upload, bookkeeping).

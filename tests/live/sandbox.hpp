@@ -48,6 +48,7 @@ struct Sandbox {
         std::string error;
         REQUIRE(app.init(o, error));
         app.frame();
+        app.settle();  // a still frame to compare with (the default's voxel bounces converge over frames)
     }
 
     // Renders frames until `done` holds; false after 30 s (a generous bound: CI machines

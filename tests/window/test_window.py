@@ -339,6 +339,9 @@ try:
     #     texture's value there; the output's row is the pixel the screen shows.
     ix, iy, iw, ih = p["image"]
     x, y = ix + iw // 3, iy + ih - 24  # the floor, clear of the texture window (top right)
+    # A still frame: the voxels' fed-back bounces converge over frames after the
+    # pipeline switch above (slow ones on a busy machine), so the screen would move on.
+    wait_for(lambda p: not p.get("settling", True), "the frame to settle", timeout=180)
     on_screen = screen_pixel(x, y, screenshot("before-trace.png"))
     sh("xdotool", "mousemove", "--window", WINDOW, str(x), str(y))
     time.sleep(0.2)
