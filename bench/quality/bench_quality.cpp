@@ -76,7 +76,9 @@ namespace {
 // The documented subset swept when no --sweep is given: the knobs the course design's report
 // discusses (voxel resolution, aperture, step schedule, trace stride) and the shadow
 // filter and map size, the indirect output's size, the lamp's model and its vertices
-// or points, the diffuse bounces. The mips, the cone set and the traced lamp change
+// or points, the diffuse bounces (the voxels' feedback off: one bounce; the in-frame
+// bounces 1–4: --pipeline bench/pipelines/default_before_feedback.json --sweep
+// voxel_mip.bounces=1,2,3,4) and how far off their surfaces the voxels gather. The mips, the cone set and the traced lamp change
 // bindings or two passes at once, so they are whole pipelines (--also
 // pipelines/iso_mips.json, pipelines/normal_cones.json, bench/pipelines/traced_lamp.json;
 // sweep cone_trace.cones with --pipeline pipelines/normal_cones.json).
@@ -85,7 +87,8 @@ const char* const kDefaultSweeps[] = {
     "cone_trace.aperture=30,45,60,90", "cone_trace.schedule=octave,continuous", "cone_trace.trace_stride=1,2,4",
     "composite.pcf=1,3,5,9",          "shadow.size=512,1024,2048,4096",
     "cone_trace.output_divisor=1,2",  "composite.lamp_samples=8,16,32",
-    "voxel_mip.bounces=1,2,3,4",      "composite.lamp_model=field,contour,points",
+    "voxel_mip.feedback=false,true",  "voxel_mip.gather_diameter_offset=1,1.25,1.5",
+    "composite.lamp_model=field,contour,points",
 };
 
 struct Args {
