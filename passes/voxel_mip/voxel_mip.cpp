@@ -36,10 +36,19 @@
 // every block of gather_block³ voxels that holds a surface traces the fixed cone set
 // through them (shaders/voxel_mip/bounce.comp), level 0 becomes the input plus albedo ×
 // that mean incoming radiance, and the chains are rebuilt from it. Deterministic and
-// bounded: each bounce adds at most albedo × the last one (no feedback across frames,
-// nothing to converge or to lag behind motion), so the frame shows exactly k bounces
-// and the path tracer with max_bounces = k + 1 is its ground truth
+// bounded: each bounce adds at most albedo × the last one, so the frame shows exactly
+// k bounces and the path tracer with max_bounces = k + 1 is its ground truth
 // (tests/gi/test_bounces.cpp, with the white furnace's 2 − 0.5^k).
+//
+// Feedback (`feedback`, the default pipeline's). Level 0 starts as the input plus what
+// each surface voxel reflects of the light its block gathered last frame (the
+// `feedback` internal), the k − 1 bounces follow as above, and one more gather is kept
+// for the next frame. Frame n from a cold start shows n·k bounces; the frames converge
+// to every bounce (the furnace: 1.968 of 2), geometrically at about the albedo a frame,
+// and the reflected light is a frame behind motion. After a change the pass asks the
+// host for kFeedbackSettleFrames more frames (ctx.keepRunning), so a paused frame
+// converges and then is skipped again. One gather and one chain build a frame (k = 1)
+// instead of k − 1 and k: 5.7 ms at 720² against three bounces' 12.4.
 //
 // Facing (`facing`, needs `normal`). A voxel holds one radiance and one opacity; a
 // cone leaving a surface met that surface's own voxels through the coarse levels, lit
