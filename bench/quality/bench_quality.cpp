@@ -23,7 +23,7 @@
 //    once, so a slow minute of a shared machine lands on all settings alike, not on
 //    the few measured in it), and the errors of composite.hdr (radiance before bloom and tonemap)
 //    against the reference: RMSE, relative MSE, SSIM, PSNR; emitters (pixels the
-//    G-buffer marks emissive) masked out. Also the relative MSE of the indirect part
+//    G-buffer marks emissive) and the pixels next to them masked out. Also the relative MSE of the indirect part
 //    alone (total − direct: the setting run again with composite.indirect_strength 0,
 //    the reference's own `direct` output) and per region of the box (floor, walls,
 //    ceiling, objects; from the G-buffer depth's world position).
@@ -367,14 +367,22 @@ struct Result {
     bool pareto = false;
 };
 
-// Every pixel counted but those showing an emitter (nonzero G-buffer emission).
+// Every pixel counted but those showing an emitter (nonzero G-buffer emission) and
+// those next to one: the reference integrates over each pixel's area, so a pixel on an
+// emitter's edge holds part of its glow, which a rasterizer sampling pixel centres does
+// not (the ceiling beside the dome read 0.82x the reference's light with them).
 metrics::Mask emittersMasked(const FloatImage& glow) {
+    auto glows = [&](int x, int y) {
+        if (x < 0 || y < 0 || x >= glow.width || y >= glow.height) return false;
+        const float* e = glow.at(x, y);
+        return e[0] + e[1] + e[2] > 0.0f;
+    };
     metrics::Mask mask(size_t(glow.width) * glow.height, 1);
     for (int y = 0; y < glow.height; ++y)
-        for (int x = 0; x < glow.width; ++x) {
-            const float* e = glow.at(x, y);
-            if (e[0] + e[1] + e[2] > 0.0f) mask[size_t(y) * glow.width + x] = 0;
-        }
+        for (int x = 0; x < glow.width; ++x)
+            for (int dy = -1; dy <= 1; ++dy)
+                for (int dx = -1; dx <= 1; ++dx)
+                    if (glows(x + dx, y + dy)) mask[size_t(y) * glow.width + x] = 0;
     return mask;
 }
 
