@@ -76,17 +76,17 @@ public:
                              "splat: a compute pass adds each particle to the voxels it overlaps; mesh: rasterize "
                              "its octahedron like every other mesh"))
             .param(floatParam("fireball_emission", 1.0f, 0.0, 1.0,
-                              "the fireballs' emission in the voxels (fireball_mode mesh): 1, they light surfaces "
+                              "the fireballs' emission in the voxels: 1, they light surfaces "
                               "through the cones; 0 when composite lights surfaces with them directly "
                               "(composite.fireball_light analytic) and the voxels keep only what they light"))
             .param(boolParam("fireball_flux", false,
                              "scale each fireball's emission by pi r^2 / (2r + h)^2 (h: the voxel side), so its "
-                             "voxelized blob carries the sphere's flux (fireball_mode mesh)"))
+                             "voxelized blob carries the sphere's flux"))
             .param(enumParam("fireball_mode", "mesh", {"mesh", "splat"},
                              "mesh: rasterize its sphere like every other mesh; splat: a compute pass adds each "
-                             "fireball, as one fragment, to the voxels its surface passes through (cheaper with "
-                             "many fireballs; at 256^2 relMSE 0.0655 against 0.0645: one fragment weighs less "
-                             "than the mesh's several where it shares a voxel)"))
+                             "fireball, as one fragment, to the voxels its surface passes through (as accurate: "
+                             "relMSE 0.0128 against 0.0130 at 256^2, t = 0; 50 fireballs cost the 720^2 frame "
+                             "1.17x two where the mesh costs 1.32x)"))
             .param(floatParam("lamp_emission", 0.0f, 0.0, 1.0,
                               "scale of the lamp dome's own emission in the voxels (its light already arrives "
                               "through composite's direct term: 1 counts it twice)"))
@@ -181,6 +181,8 @@ private:
         glUniform1ui(glGetUniformLocation(splatter, "u_first"), first);
         glUniform1ui(glGetUniformLocation(splatter, "u_sphereCount"), count);
         glUniform1ui(glGetUniformLocation(splatter, "u_litCount"), fireballs);
+        glUniform1f(glGetUniformLocation(splatter, "u_fireballEmission"), ctx.getFloat("fireball_emission"));
+        glUniform1i(glGetUniformLocation(splatter, "u_sphereFlux"), ctx.getBool("fireball_flux") ? 1 : 0);
         glDispatchCompute((count + 63) / 64, 1, 1);
         return true;
     }

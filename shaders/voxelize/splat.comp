@@ -5,9 +5,10 @@
 // the same fixed-point sums and count as voxelize.frag, so resolve.comp averages it with
 // the surfaces around it. A sphere smaller than a voxel lands in the voxels its bounding
 // box overlaps (at most 2×2×2).
-//   fireballs  emission plus the lamp's light on the surface point facing the voxel's
-//              centre, lit as voxelize.frag lights a fragment (surface.glsl): the first
-//              u_litCount spheres.
+//   fireballs  emission (scaled as the rasterized ones: fireball_emission, and with
+//              fireball_flux to the sphere's flux) plus the lamp's light on the surface
+//              point facing the voxel's centre, lit as voxelize.frag lights a fragment
+//              (surface.glsl): the first u_litCount spheres.
 //   particles  emitters with no albedo: their emission, no surface (albedo, normal); the rest.
 // The spheres are the instances [u_first, u_first + u_sphereCount) of the scene's
 // instance buffer. Cost: a few atomics per voxel of the shell, where rasterizing the mesh cost a
@@ -23,6 +24,8 @@ layout(local_size_x = 64) in;
 uniform uint u_first;
 uniform uint u_sphereCount;
 uniform uint u_litCount;
+uniform float u_fireballEmission;  // voxelize's fireball_emission, as the rasterized fireballs take it
+uniform bool u_sphereFlux;         // fireball_flux: each fireball's blob at its sphere's flux
 
 void main() {
     if (gl_GlobalInvocationID.x >= u_sphereCount) return;
@@ -33,6 +36,7 @@ void main() {
     ivec3 lo = max(ivec3(floor(((centre - radius) * 0.5 + 0.5) * float(u_res))), ivec3(0));
     ivec3 hi = min(ivec3(floor(((centre + radius) * 0.5 + 0.5) * float(u_res))), ivec3(u_res - 1));
     uvec3 emitted = toFixedRadiance(inst.emissive.rgb);
+    vec3 fireballEmission = inst.emissive.rgb * u_fireballEmission * (u_sphereFlux ? sphereFluxScale(radius) : 1.0);
     for (int z = lo.z; z <= hi.z; ++z)
         for (int y = lo.y; y <= hi.y; ++y)
             for (int x = lo.x; x <= hi.x; ++x) {
@@ -44,7 +48,7 @@ void main() {
                 if (gl_GlobalInvocationID.x < u_litCount) {
                     vec3 towards = 0.5 * (cubeLo + cubeHi) - centre;
                     vec3 n = dot(towards, towards) > 1e-12 ? normalize(towards) : vec3(0.0, 1.0, 0.0);
-                    uvec3 lit = toFixedRadiance(lampReflected(inst.albedo.rgb, centre + n * radius, n) + inst.emissive.rgb);
+                    uvec3 lit = toFixedRadiance(lampReflected(inst.albedo.rgb, centre + n * radius, n) + fireballEmission);
                     addSurfaceToVoxel(ivec3(x, y, z), lit, inst.albedo.rgb, n);
                 } else {
                     addToVoxel(ivec3(x, y, z), emitted);

@@ -28,15 +28,8 @@ void main() {
     vec3 albedo = inst.albedo.rgb;
     if (inst.albedo.a > 0.5) albedo = woodGrain(v_world);
     vec3 n = normalize(v_normal);
-    // A conservatively voxelized sphere of radius r on voxels of side h presents about
-    // (2r + h)² to a cone where the sphere presents πr²: at its full radiance the blob
-    // would carry several times the sphere's flux (0.34 of it is right for a 6 cm fireball
-    // at 32³).
     float scale = u_emissionScale;
-    if (u_sphereFlux) {
-        float r = kilnSphereRadius(inst), h = 2.0 / float(u_res);
-        scale *= min(1.0, 3.14159265 * r * r / ((2.0 * r + h) * (2.0 * r + h)));
-    }
+    if (u_sphereFlux) scale *= sphereFluxScale(kilnSphereRadius(inst));
     vec3 radiance = lampReflected(albedo, v_world, n) + inst.emissive.rgb * scale;
     uvec3 fixedRgb = toFixedRadiance(radiance);
 

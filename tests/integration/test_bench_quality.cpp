@@ -209,10 +209,12 @@ TEST_CASE("the default pipeline is closer to the path-traced reference than the 
     // half-size image, and at 96² those 12×12 samples smear the lamp's light on the
     // ceiling (the mean light falls to 0.94×). 128 paths, not more: the render dominates
     // the suite's time, and the figures asserted are noise-corrected or means.
-    // Measured (noise-corrected relMSE): 0.0168 against 0.0581, the indirect part 0.0223
-    // against 0.129; the mean luminance 0.967× the reference's against 0.777× (issue
-    // 22: the course design's one bounce misses a fifth of the light, the default's
-    // three bounces all but the fourth and later ones, about 2.5 % here). SSIM is
+    // Measured (noise-corrected relMSE): 0.0206 against 0.0553, the indirect part 0.0310
+    // against 0.128; the mean luminance 1.032× the reference's against 0.790× (issue
+    // 22: the course design's one bounce misses a fifth of the light; the default has
+    // every bounce, fed back across frames, and the first ones' over-reflection shows:
+    // 0.967× with three in-frame bounces, which left out the fourth and later). Bounds
+    // 0.95–1.05: a missing bounce (0.89× with two) or a doubled one fails. SSIM is
     // withheld at this path count (the halves disagree).
     const std::string out = std::string(TEST_OUTPUT_DIR) + "/bench-quality-default-vs-course";
     Run r = runProgram(KILN_BENCH_QUALITY,
@@ -238,7 +240,7 @@ TEST_CASE("the default pipeline is closer to the path-traced reference than the 
     CHECK(indirect[0] < indirect[1]);
     INFO("mean luminance ÷ the reference's: default " << light[0] << ", course " << light[1]);
     CHECK(light[0] > 0.95);
-    CHECK(light[0] < 1.03);
+    CHECK(light[0] < 1.05);
     CHECK(light[1] < 0.9);
 
     // --images: each setting's frame and indirect part and the reference's, at the size;
