@@ -46,7 +46,9 @@ public:
 
     void execute(kiln::PassContext& ctx) override {
         GLuint brightPass = ctx.program({.stages = {"bloom/bright.comp"}});
-        GLuint blur = ctx.program({.stages = {"bloom/blur.vert", "bloom/blur.frag"}});
+        const int taps = (ctx.getInt("radius") + 1) / 2;  // per side, at half resolution
+        GLuint blur = ctx.program({.stages = {"bloom/blur.vert", "bloom/blur.frag"},
+                                   .defines = {{"KILN_BLUR_RADIUS", std::to_string(taps)}}});
         if (!brightPass || !blur) return;
         const kiln::TextureRef& in = ctx.input("color");
         const kiln::TextureRef& bright = ctx.internal("bright");
@@ -66,8 +68,13 @@ public:
 
         // 2. Horizontal blur → ping; vertical → bloom.
         glUseProgram(blur);
-        glUniform1i(glGetUniformLocation(blur, "u_radius"), (ctx.getInt("radius") + 1) / 2);
-        glUniform1f(glGetUniformLocation(blur, "u_sigma"), std::max(0.5f, float(ctx.getInt("radius")) * 0.25f));
+        // Gaussian weights of σ = radius/4 half-resolution pixels (radius/2 full ones), normalised.
+        const float sigma = std::max(0.5f, float(ctx.getInt("radius")) * 0.25f);
+        float weights[9] = {};
+        float total = 0.0f;
+        for (int i = 0; i <= taps; ++i) total += (i ? 2.0f : 1.0f) * (weights[i] = std::exp(-float(i * i) / (2.0f * sigma * sigma)));
+        for (int i = 0; i <= taps; ++i) weights[i] /= total;
+        glUniform1fv(glGetUniformLocation(blur, "u_weights"), taps + 1, weights);
         // Black where nothing is drawn (blur.vert collapses the triangle when nothing is bright).
         const float black[4] = {0.0f, 0.0f, 0.0f, 1.0f};
         if (!ctx.framebuffer({"ping"})) return;
