@@ -58,8 +58,8 @@ public:
                               "compiles that out"))
             .param(intChoiceParam("lamp_field_size", 64, {32, 64, 128},
                                   "lamp_model field: grid nodes per side over the box (64: 3.2 cm apart, 2 MiB; "
-                                  "next to the dome within the reference's noise, as 128 is, and 1.6 ms cheaper at "
-                                  "720^2 than 128, whose 16 MiB miss the caches)"))
+                                  "next to the dome within the reference's noise, as 128 is, and composite 1.5 ms cheaper at "
+                                  "720^2 than 128)"))
             .param(intChoiceParam("lamp_samples", 32, {4, 8, 16, 32, 64},
                                   "vertices of the lamp's silhouette (contour) or quadrature points over its cap (points)"));
         d.reads = kSceneLight | kSceneCamera | kSceneFireballs;
