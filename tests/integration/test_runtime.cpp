@@ -118,6 +118,33 @@ TEST_CASE("a pass whose inputs, parameters and scene did not change is skipped",
     }
 }
 
+TEST_CASE("a pass that asks to keep running gets its frames after each change, not more, and then skips",
+          "[runtime][gl]") {
+    // The default's voxel_mip feeds its bounces back and asks for 16 frames after each
+    // run that a change caused (PassContext::keepRunning). Its settling frames do not
+    // extend themselves; a change part way through starts the count again; a paused
+    // frame after them skips it.
+    Fixture f;
+    auto voxelMip = [&] {
+        for (const auto& row : f.app.runtime().stats())
+            if (row.id == "voxel_mip") return row;
+        FAIL("no voxel_mip row");
+        return run::PassRow{};
+    };
+    f.app.frame();
+    for (int i = 0; i < 5; ++i) f.app.frame();
+    CHECK(voxelMip().ranFrames == 6);
+    CHECK(voxelMip().why.find("settling (voxel bounces fed back): 11 more frames") != std::string::npos);
+    std::string error;
+    REQUIRE(f.app.runtime().setParam("voxel_mip", "gather_diameter_offset", ParamValue(1.25f), error));
+    f.app.frame();  // the change: a run of its own, and 16 frames again from here
+    CHECK(f.app.settle() == 16);
+    CHECK(voxelMip().ranFrames == 6 + 1 + 16);
+    f.app.frame();
+    CHECK(voxelMip().state == "skipped");
+    CHECK(voxelMip().ranFrames == 23);
+}
+
 TEST_CASE("viewing a culled pass's texture un-culls it without renewing other textures", "[runtime][gl]") {
     Fixture f;
     std::string errors;
