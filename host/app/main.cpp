@@ -59,6 +59,7 @@ int watch(App& app, const Options& o) {
         app.frame();
         if (app.live().applied() != applied) {
             applied = app.live().applied();
+            app.settle();  // the edit's frame converged, as the first --out was
             std::string error;
             if (!writeOutputs(app, o, error)) log::error(error);
         }

@@ -148,8 +148,8 @@ namespace kiln {
 
 // Bump when anything in this header (or what it includes) changes layout or vtables,
 // or when what the host does for a pass changes (6: the host issues the barrier
-// between passes; 7: GpuFrame::boxWalls; 8: PassContext::keepRunning), so a module built for other terms is refused
-// by name, not run.
+// between passes; 7: GpuFrame::boxWalls; 8: PassContext::keepRunning), so a module
+// built for other terms is refused by name, not run.
 inline constexpr uint32_t kPassAbiVersion = 8;
 
 struct TextureRef {
