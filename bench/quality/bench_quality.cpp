@@ -431,9 +431,10 @@ bool measure(app::App& app, const Args& args, const Setting& setting, const Refe
         return fail(setting.label + ": " + error);
     app.runtime().setRequested({"composite.hdr", "gbuffer.emissive", "gbuffer.depth"});
     app.runtime().alwaysRun = true;
-    // Compile, allocate, and let what converges over frames settle (voxel_mip's feedback
-    // asks 16 frames after a change; the previous setting's state is then forgotten).
-    for (int f = 0; f < 18; ++f) app.frame();
+    // Compile, allocate, and let what converges over frames settle (as many frames as
+    // the passes ask for with keepRunning: voxel_mip's feedback 16 after a change).
+    for (int f = 0; f < 2; ++f) app.frame();
+    app.settle();
     glFinish();
     app.runtime().resetTimings();
     for (int f = 0; f < args.frames; ++f) app.frame();

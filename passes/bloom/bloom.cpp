@@ -72,7 +72,10 @@ public:
         const float sigma = std::max(0.5f, float(ctx.getInt("radius")) * 0.25f);
         float weights[9] = {};
         float total = 0.0f;
-        for (int i = 0; i <= taps; ++i) total += (i ? 2.0f : 1.0f) * (weights[i] = std::exp(-float(i * i) / (2.0f * sigma * sigma)));
+        for (int i = 0; i <= taps; ++i) {
+            weights[i] = std::exp(-float(i * i) / (2.0f * sigma * sigma));
+            total += i == 0 ? weights[i] : 2.0f * weights[i];  // taps ±i share a weight
+        }
         for (int i = 0; i <= taps; ++i) weights[i] /= total;
         glUniform1fv(glGetUniformLocation(blur, "u_weights"), taps + 1, weights);
         // Black where nothing is drawn (blur.vert collapses the triangle when nothing is bright).

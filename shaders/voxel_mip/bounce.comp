@@ -75,32 +75,32 @@ vec3 gatherBlock(ivec3 block) {
     return sum / max(weights, 1e-6);
 }
 
+// Voxel v's radiance as voxelize left it (direct light, emission) plus, where it holds a
+// reflecting surface, albedo × the mean radiance arriving at it.
+vec4 reflecting(ivec3 v, vec3 incoming) {
+    vec4 radiance = texelFetch(u_emitted, v, 0);
+    vec3 albedo = texelFetch(u_albedo, v, 0).rgb;
+    if (reflects(radiance, albedo)) radiance.rgb += albedo * incoming * radiance.a;
+    return radiance;
+}
+
 void main() {
     ivec3 block = ivec3(gl_GlobalInvocationID);
     int res = int(u_voxelRes);
     if (any(greaterThanEqual(block * kBlock, ivec3(res)))) return;
-#if KILN_BOUNCE_STEP == 2
-    // Apply the last frame's gather (feedback): what each surface voxel reflects of it.
-    for (int i = 0; i < kBlock * kBlock * kBlock; ++i) {
-        ivec3 v = voxelOf(block, i);
-        vec4 radiance = texelFetch(u_emitted, v, 0);
-        vec3 albedo = texelFetch(u_albedo, v, 0).rgb;
-        if (reflects(radiance, albedo)) radiance.rgb += albedo * texelFetch(u_gathered, v, 0).rgb * radiance.a;
-        imageStore(u_bounced, v, radiance);
-    }
-#else
+#if KILN_BOUNCE_STEP != 2
     vec3 gathered = gatherBlock(block);
+#endif
     for (int i = 0; i < kBlock * kBlock * kBlock; ++i) {
         ivec3 v = voxelOf(block, i);
-#if KILN_BOUNCE_STEP == 1
+#if KILN_BOUNCE_STEP == 0
+        imageStore(u_bounced, v, reflecting(v, gathered));
+#elif KILN_BOUNCE_STEP == 1
         // Kept for the next frame (feedback): the gather itself, reflected there.
         imageStore(u_bounced, v, vec4(gathered, 1.0));
 #else
-        vec4 radiance = texelFetch(u_emitted, v, 0);
-        vec3 albedo = texelFetch(u_albedo, v, 0).rgb;
-        if (reflects(radiance, albedo)) radiance.rgb += albedo * gathered * radiance.a;
-        imageStore(u_bounced, v, radiance);
+        // The last frame's gather (feedback), reflected: this frame's level 0.
+        imageStore(u_bounced, v, reflecting(v, texelFetch(u_gathered, v, 0).rgb));
 #endif
     }
-#endif
 }
