@@ -283,6 +283,10 @@ TEST_CASE("voxelize fireball_flux: the voxels take each fireball at pi r^2 / (2r
                                                               "radius": 0.08, "color": [1.0, 0.5, 0.1]}]})";
     Rig rig(file.string(), 32);
     std::string error;
+    // Both ways a fireball reaches the voxels: its mesh rasterized, or splatted.
+    const std::string mode = GENERATE(std::string("mesh"), std::string("splat"));
+    INFO("fireball_mode " << mode);
+    REQUIRE(rig.app.runtime().setParam("voxelize", "fireball_mode", ParamValue(mode), error));
     auto voxels = [&](bool flux, float emission) {
         REQUIRE(rig.app.runtime().setParam("voxelize", "fireball_flux", ParamValue(flux), error));
         REQUIRE(rig.app.runtime().setParam("voxelize", "fireball_emission", ParamValue(emission), error));
