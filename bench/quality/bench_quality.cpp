@@ -222,7 +222,7 @@ constexpr double kSsimMeaningful = 0.97;
 // The reference as two independent halves and their mean; each also as its indirect
 // part (radiance − direct), which is what the indirect figures compare.
 struct Reference {
-    FloatImage halves[2], halvesIndirect[2];
+    FloatImage halves[2], halvesIndirect[2], halvesDirect[2];
     FloatImage mean, meanIndirect;  // R = (A + B)/2: what the errors are measured against
     double renderSeconds = 0;       // rendering this run (0: both from the cache)
 };
@@ -300,12 +300,11 @@ bool referenceHalf(app::App& app, const Args& args, int half, FloatImage& out, F
 }
 
 bool loadReference(app::App& app, const Args& args, Reference& ref) {
-    FloatImage directs[2];
     for (int half = 0; half < 2; ++half) {
         double seconds = 0;
-        if (!referenceHalf(app, args, half, ref.halves[half], directs[half], seconds)) return false;
+        if (!referenceHalf(app, args, half, ref.halves[half], ref.halvesDirect[half], seconds)) return false;
         ref.renderSeconds += seconds;
-        ref.halvesIndirect[half] = metrics::difference(ref.halves[half], directs[half]);
+        ref.halvesIndirect[half] = metrics::difference(ref.halves[half], ref.halvesDirect[half]);
     }
     ref.mean = metrics::average(ref.halves[0], ref.halves[1]);
     ref.meanIndirect = metrics::average(ref.halvesIndirect[0], ref.halvesIndirect[1]);
@@ -357,8 +356,8 @@ struct Result {
     double regionRelMse[kRegionCount] = {};
     // Less the reference's own noise: estimates of the error against the truth.
     double relMseCorrected = 0, indirectRelMseCorrected = 0;
-    // Mean luminance of the setting ÷ that of R, total and indirect, per part.
-    metrics::RatioWithUncertainty meanRatio[kPartCount], indirectRatio[kPartCount];
+    // Mean luminance of the setting ÷ that of R, total, indirect and direct, per part.
+    metrics::RatioWithUncertainty meanRatio[kPartCount], indirectRatio[kPartCount], directRatio[kPartCount];
     // The ceiling around the dome: corrected relMSE, the reference's own noise there, bias.
     double ringRelMseCorrected = 0, ringNoise = 0;
     int ringPixels = 0;
@@ -396,15 +395,18 @@ void domeRingFigures(const FloatImage& image, const Reference& ref, const metric
     r.ringRatio = metrics::meanLuminanceRatio(image, ref.halves[0], ref.halves[1], ring);
 }
 
-// The indirect part's errors and bias per region (image less the frame without it).
-void indirectFigures(const FloatImage& indirect, const Reference& ref, const metrics::Mask& mask,
-                     const std::vector<metrics::Mask>& partMask, Result& r) {
+// The indirect part's errors and bias per region (image less the frame without it), and
+// the direct part's bias (the frame without it: the lamp's light and what is seen glowing).
+void indirectFigures(const FloatImage& indirect, const FloatImage& direct, const Reference& ref,
+                     const metrics::Mask& mask, const std::vector<metrics::Mask>& partMask, Result& r) {
     const FloatImage& indirectA = ref.halvesIndirect[0];
     const FloatImage& indirectB = ref.halvesIndirect[1];
     r.indirectRelMse = metrics::relativeMse(indirect, ref.meanIndirect, mask);
     r.indirectRelMseCorrected = metrics::noiseCorrectedRelativeMse(indirect, indirectA, indirectB, mask);
     for (int p = 0; p < kPartCount; ++p)
         r.indirectRatio[p] = metrics::meanLuminanceRatio(indirect, indirectA, indirectB, partMask[p]);
+    for (int p = 0; p < kPartCount; ++p)
+        r.directRatio[p] = metrics::meanLuminanceRatio(direct, ref.halvesDirect[0], ref.halvesDirect[1], partMask[p]);
 }
 
 // --images: OUT/images/LABEL.exr and LABEL.indirect.exr ('/' in a label becomes '_').
@@ -483,9 +485,9 @@ bool score(app::App& app, const Args& args, const std::string& label, const Refe
     if (!app.runtime().setParam("composite", "indirect_strength", 0.0f, error)) return fail(label + ": " + error);
     app.frame();
     glFinish();
-    const FloatImage indirect =
-        metrics::difference(image, readTexture(hdr->id, hdr->target, hdr->format, hdr->width, hdr->height));
-    indirectFigures(indirect, ref, mask, partMask, r);
+    const FloatImage direct = readTexture(hdr->id, hdr->target, hdr->format, hdr->width, hdr->height);
+    const FloatImage indirect = metrics::difference(image, direct);
+    indirectFigures(indirect, direct, ref, mask, partMask, r);
     if (args.images && !writeImages(args, label, image, indirect)) return false;
     r.counted = mask;
     // The ratios may be NaN (a region out of view): they are printed as n/a, not checked.
@@ -613,7 +615,9 @@ void writeErrors(const std::vector<Result>& results, bool ssimMeaningful, const 
     for (const char* kind : {"mean_ratio_", "indirect_ratio_"})
         for (const char* part : kPartNames) csv << ',' << kind << part << ',' << kind << part << "_uncertainty";
     csv << ",dome_ring_pixels,rel_mse_dome_ring_corrected,ref_noise_dome_ring,mean_ratio_dome_ring,"
-           "mean_ratio_dome_ring_uncertainty,pass_ms\n";
+           "mean_ratio_dome_ring_uncertainty,pass_ms";
+    for (const char* part : kPartNames) csv << ",direct_ratio_" << part << ",direct_ratio_" << part << "_uncertainty";
+    csv << '\n';
     std::printf("%-44s %9s %9s %9s %9s %7s %7s %9s %9s  %-31s %s\n", "setting", "gpu ms", "RMSE", "relMSE", "corrected",
                 "SSIM", "PSNR", "indirect", "corrected", "relMSE floor/walls/ceil/objects", "front");
     for (const Result& r : results) {
@@ -635,7 +639,10 @@ void writeErrors(const std::vector<Result>& results, bool ssimMeaningful, const 
                 csv << ',' << csvNumber(ratios[p].ratio) << ',' << csvNumber(ratios[p].uncertainty);
         csv << ',' << r.ringPixels << ',' << r.ringRelMseCorrected << ',' << r.ringNoise << ','
             << csvNumber(r.ringRatio.ratio) << ',' << csvNumber(r.ringRatio.uncertainty);
-        csv << ",\"" << passes << "\"\n";
+        csv << ",\"" << passes << '"';
+        for (int p = 0; p < kPartCount; ++p)
+            csv << ',' << csvNumber(r.directRatio[p].ratio) << ',' << csvNumber(r.directRatio[p].uncertainty);
+        csv << '\n';
     }
     std::printf("\n* = on the Pareto front of (GPU ms, corrected relMSE); corrected = less the reference's own noise\n\n");
 }
