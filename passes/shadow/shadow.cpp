@@ -1,5 +1,5 @@
 // shadow — depth of the shadow casters (tumblers, marbles; fireballs emit, they don't
-// cast) seen from the lamp, one perspective 2D map (projection in common/light.glsl).
+// cast) seen from the lamp, one perspective 2D map (projection in common/shadow.glsl).
 // It reads only the casters and the light, so the host skips it while they are still
 // (a flying fireball alone changes nothing here).
 #include <kiln/pass.hpp>
@@ -12,8 +12,8 @@ public:
         using namespace kiln;
         PassDeclaration d;
         d.output({.name = "depth", .kind = TextureKind::Depth2D, .format = Format::Depth32F,
-                  .size = SizeRule::fromParam("size"), .doc = "depth from the lamp; see common/light.glsl",
-                  .depthNear = 0.05f, .depthFar = 3.5f})  // light.glsl kLightNear, kLightFar
+                  .size = SizeRule::fromParam("size"), .doc = "depth from the lamp; see common/shadow.glsl",
+                  .depthNear = 0.05f, .depthFar = 3.5f})  // shadow.glsl kLightNear, kLightFar
             .param(intChoiceParam("size", 2048, {256, 512, 1024, 2048, 4096}, "shadow map side in texels"))
             .param(floatParam("slope_bias", 2.0f, 0.0, 10.0, "polygon offset factor against shadow acne"));
         d.reads = kSceneShadowCasters | kSceneLight;

@@ -1,37 +1,4 @@
-// The lamp's shadow projection, shared by the shadow pass and everything that reads
-// its map. A perspective view from the lamp centre (above the ceiling, outside the
-// box) looking straight down: one 2D map covers the box below the lamp.
-// 140° field of view: the floor and every caster are inside; the topmost corners of
-// the walls (y > 0.85, receivers only, already shaded by the lamp's directional
-// falloff) fall outside and read as lit.
 #include "frame.glsl"
-
-const float kLightNear = 0.05;
-const float kLightFar = 3.5;
-
-mat4 lightViewProj() {
-    vec3 eye = u_lightPos.xyz;
-    // lookAt(eye, eye − y, up = −z)
-    mat4 view = mat4(1.0, 0.0, 0.0, 0.0,
-                     0.0, 0.0, 1.0, 0.0,
-                     0.0, -1.0, 0.0, 0.0,
-                     -eye.x, eye.z, -eye.y, 1.0);
-    float f = 1.0 / tan(radians(140.0) * 0.5);
-    mat4 proj = mat4(f, 0.0, 0.0, 0.0,
-                     0.0, f, 0.0, 0.0,
-                     0.0, 0.0, (kLightFar + kLightNear) / (kLightNear - kLightFar), -1.0,
-                     0.0, 0.0, 2.0 * kLightFar * kLightNear / (kLightNear - kLightFar), 0.0);
-    return proj * view;
-}
-
-// Shadow-map coordinates of a world point: xy in [0,1], z = depth in [0,1]; w = 0
-// when the point is outside the light's frustum.
-vec4 lightSpace(vec3 world) {
-    vec4 c = lightViewProj() * vec4(world, 1.0);
-    vec3 ndc = c.xyz / c.w;
-    float inside = (c.w > 0.0 && all(lessThan(abs(ndc), vec3(1.0)))) ? 1.0 : 0.0;
-    return vec4(ndc * 0.5 + 0.5, inside);
-}
 
 // The lamp, defined once (scene file `lamp`): the part of the sphere u_lightPos (xyz
 // centre, w radius) below the ceiling y = 1, a Lambertian emitter of radiance
@@ -270,33 +237,3 @@ vec3 lampLight(vec3 p, vec3 n) {
     return u_lightColor.rgb * (sum * area / float(KILN_LAMP_SAMPLES));
 }
 #endif
-
-// One hard shadow-map test: 1 where p is nearer the lamp than the caster depth
-// stored for its texel. Outside the light's frustum: lit.
-float shadowHard(sampler2D shadowMap, vec3 p, float bias) {
-    vec4 ls = lightSpace(p);
-    return ls.w == 0.0 || ls.z - bias <= texture(shadowMap, ls.xy).r ? 1.0 : 0.0;
-}
-
-// Fraction of the lamp that sees p: a percentage-closer filter through a comparison
-// sampler (GL_LINEAR + GL_COMPARE_REF_TO_TEXTURE, GL_LEQUAL), so each lookup is
-// already a bilinear blend of four depth tests. KILN_PCF = k: (k+1)/2 × (k+1)/2
-// lookups two texels apart, a smooth filter about k+1 texels wide (5 → 9 lookups over
-// 6×6 texels, where a nearest-texel 5×5 box needs 25). Unrolled: the kernel is a
-// compile-time constant (on llvmpipe a loop with a uniform bound, and a branch around
-// taps, cost more than the taps). Outside the light's frustum: lit.
-#ifndef KILN_PCF
-#define KILN_PCF 5
-#endif
-float shadowFiltered(sampler2DShadow shadowMap, vec3 p, float bias) {
-    vec4 ls = lightSpace(p);
-    const int n = (KILN_PCF + 1) / 2;
-    vec2 texel = 1.0 / vec2(textureSize(shadowMap, 0));
-    float lit = 0.0;
-    for (int y = 0; y < n; ++y)
-        for (int x = 0; x < n; ++x) {
-            vec2 offset = (vec2(x, y) * 2.0 - float(n - 1)) * texel;
-            lit += texture(shadowMap, vec3(ls.xy + offset, ls.z - bias));
-        }
-    return ls.w == 0.0 ? 1.0 : lit / float(n * n);
-}

@@ -5,6 +5,7 @@
 // metrics compare with the reference.
 #include "common/frame.glsl"
 #include "common/light.glsl"
+#include "common/shadow.glsl"
 #include "common/tonemap.glsl"
 
 in vec2 v_uv;

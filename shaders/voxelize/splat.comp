@@ -16,6 +16,7 @@
 #include "common/frame.glsl"
 #include "common/instances.glsl"
 #include "common/light.glsl"
+#include "common/shadow.glsl"
 #include "sums.glsl"
 #include "surface.glsl"
 

@@ -2,7 +2,7 @@
 // (voxelize.frag) and the splatted spheres (splat.comp): the lamp's diffuse light
 // (common/light.glsl) with one hard shadow-map test, taken one voxel off the surface
 // along its normal (against acne). Emission is the caller's to add.
-// Needs common/light.glsl; binds the shadow map at texture unit 0.
+// Needs common/light.glsl and common/shadow.glsl; binds the shadow map at texture unit 0.
 layout(binding = 0) uniform sampler2D u_shadowMap;
 uniform int u_res;          // voxels per side
 uniform float u_shadowBias;

@@ -6,6 +6,7 @@
 #include "common/frame.glsl"
 #include "common/instances.glsl"
 #include "common/light.glsl"
+#include "common/shadow.glsl"
 #include "common/wood.glsl"
 #include "sums.glsl"
 #include "surface.glsl"
