@@ -51,15 +51,15 @@ public:
                              "polygon, also next to the dome); points = a quadrature over the cap (lobes near it); "
                              "traced = the contour evaluated by cone_trace (its `lamp` on) where it traces, read "
                              "from the indirect input's alpha; field = n · the lamp's vector irradiance, from a "
-                             "grid of lamp_field_size³ built when the lamp changes (one lookup a pixel)"))
+                             "grid of lamp_field_size² over (distance from its axis, height) built when the lamp changes (one "
+                             "lookup a pixel)"))
             .param(floatParam("lamp_near_field", 0.2f, 0.0, 4.0,
                               "lamp_model traced or field: within this many metres of the dome the contour is "
                               "evaluated per pixel (the irradiance changes faster there than the samples); 0 "
                               "compiles that out"))
-            .param(intChoiceParam("lamp_field_size", 64, {32, 64, 128},
-                                  "lamp_model field: grid nodes per side over the box (64: 3.2 cm apart, 2 MiB; "
-                                  "next to the dome within the reference's noise, as 128 is, and composite 1.5 ms cheaper at "
-                                  "720^2 than 128)"))
+            .param(intChoiceParam("lamp_field_size", 256, {32, 64, 128, 256, 512},
+                                  "lamp_model field: nodes per side of the lamp's axisymmetric grid (distance from "
+                                  "its axis x height; 256: 5.5 x 7.8 mm apart, 256 KiB)"))
             .param(intChoiceParam("lamp_samples", 32, {4, 8, 16, 32, 64},
                                   "vertices of the lamp's silhouette (contour) or quadrature points over its cap (points)"));
         d.reads = kSceneLight | kSceneCamera | kSceneFireballs;
@@ -140,8 +140,8 @@ private:
         ctx.drawFullscreenTriangle();
     }
 
-    // lamp_model field: the grid (the pass's own texture, made only in this mode: 16 MiB
-    // at 128³), rebuilt when the lamp, the grid's size or its shader changed. False when
+    // lamp_model field: the grid (the pass's own texture, made only in this mode: 1 MiB
+    // at 512²), rebuilt when the lamp, the grid's size or its shader changed. False when
     // the pass failed.
     bool buildLampField(kiln::PassContext& ctx) {
         GLuint builder = ctx.program({.stages = {"composite/lamp_field.comp"},
@@ -149,13 +149,13 @@ private:
         if (!builder) return false;
         const int side = ctx.getInt("lamp_field_size");
         if (!lampField_ || lampField_.width() != side)
-            lampField_ = kiln::gl::Texture::create(GL_TEXTURE_3D, GL_RGBA16F, side, side, side, 1, "composite.lamp_field");
+            lampField_ = kiln::gl::Texture::create(GL_TEXTURE_2D, GL_RG16F, side, side, 1, 1, "composite.lamp_field");
         const FieldKey key{ctx.scene().version(kiln::kSceneLight), side, builder};
         if (key == builtField_) return true;
         glUseProgram(builder);
-        kiln::gl::bindImage(builder, "u_field", lampField_.id(), 0, true, GL_WRITE_ONLY, GL_RGBA16F);
-        const GLuint groups = GLuint((side + 3) / 4);
-        glDispatchCompute(groups, groups, groups);
+        kiln::gl::bindImage(builder, "u_field", lampField_.id(), 0, false, GL_WRITE_ONLY, GL_RG16F);
+        const GLuint groups = GLuint((side + 7) / 8);
+        glDispatchCompute(groups, groups, 1);
         glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
         builtField_ = key;
         return true;

@@ -6,6 +6,7 @@
 #include "common/frame.glsl"
 #include "common/light.glsl"
 #include "common/shadow.glsl"
+#include "lamp_field.glsl"
 #include "common/tonemap.glsl"
 
 in vec2 v_uv;
@@ -30,7 +31,7 @@ uniform int u_tonemap;   // kTonemapAces, kTonemapReinhard, kTonemapClamp
 uniform float u_shadowBias;
 uniform float u_indirectStrength;
 #if KILN_LAMP_FIELD
-layout(binding = 8) uniform sampler3D u_lampField;  // F at the grid's nodes (composite/lamp_field.comp)
+layout(binding = 8) uniform sampler2D u_lampField;  // F on the lamp's axisymmetric grid (composite/lamp_field.comp)
 #endif
 uniform float u_lampNearField;  // lamp_model traced or field: metres from the dome evaluated per pixel
 
@@ -125,17 +126,15 @@ void main() {
         vec3 n = normalize(n4.xyz);
 #if KILN_LAMP_TRACED || KILN_LAMP_FIELD
         // traced: cone_trace's `lamp`, the projected solid angle where it traced,
-        // upsampled. field: n·F from the lamp's vector irradiance on a grid (exact up to
-        // the grid where the whole emitter is above the surface's horizon; where the
-        // horizon cuts it, n·F falls short of the clipped Φ — a grazing, dim band).
+        // upsampled. field: from the lamp's vector irradiance F on a grid, n·F (exact up
+        // to the grid where the whole emitter is above the surface's horizon) or, where
+        // the horizon cuts it, the clipped form of the ball F describes (lamp_field.glsl).
         // Within u_lampNearField of the dome both change faster than their samples:
         // evaluated here, by the variant composite.cpp draws over the near field's
         // screen rectangle only (on llvmpipe the contour's mere presence in the shader
         // cost every pixel of the frame, used or not).
 #if KILN_LAMP_FIELD
-        float fieldSide = float(textureSize(u_lampField, 0).x);
-        vec3 fieldCoord = (clamp(p, -1.0, 1.0) * 0.5 + 0.5) * ((fieldSide - 1.0) / fieldSide) + 0.5 / fieldSide;
-        float solidAngle = max(dot(n, textureLod(u_lampField, fieldCoord, 0.0).xyz), 0.0);
+        float solidAngle = lampFieldSolidAngle(lampFieldAt(u_lampField, p), p, n);
 #else
         float solidAngle = texture(u_indirect, v_uv).a;
 #endif
