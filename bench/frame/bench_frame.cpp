@@ -8,10 +8,12 @@
 // starting one later (a slow minute of a shared machine, or a slow slot, lands on all of
 // them); figures are medians over rounds.
 //
-// skip: the default pipeline and scene in five situations, one after the other in one
-// process: moving; paused (nothing changes: every pass may skip); moving without
-// fireballs (no particles, no moving emitters); moving with bloom culled (composite does
-// not read it); moving with bloom disabled. Per situation: each pass's median GPU and
+// skip: the default pipeline and scene in seven situations, one after the other in one
+// process: moving; paused (nothing changes: every pass may skip, once voxel_mip's
+// feedback has settled); moving without fireballs (no particles, no moving emitters);
+// moving with bloom culled (composite does not read it); moving with bloom disabled;
+// the tumblers asleep and no balls (time runs, nothing moves; settled too); and one
+// marble bouncing among the sleeping tumblers. Per situation: each pass's median GPU and
 // CPU ms over the frames it ran, how often it ran, and the median wall time per frame
 // (with a glFinish, what a user waits for), and the ratio to "moving".
 //
@@ -93,6 +95,10 @@ struct Situation {
     std::string label;
     std::string pipelineText, sceneFile;
     bool paused = false;
+    double restSeconds = 0.0;  // simulated (not rendered) after loading: upright tumblers fall asleep
+    // Measured once converging passes have settled (App::settle: voxel_mip's feedback
+    // runs 16 frames after the last change), as a scene at rest is seen for long.
+    bool settled = false;
 };
 
 struct PassRowOut {
@@ -118,7 +124,9 @@ Outcome runSituation(app::App& app, const Situation& s, int frames) {
         std::exit(1);
     }
     app.paused = false;
+    for (double t = 0.0; t < s.restSeconds; t += app.scene().dt()) app.scene().step();
     for (int f = 0; f < 3; ++f) app.frame();
+    if (s.settled) app.settle();
     app.paused = s.paused;
     app.frame();  // the paused state's first frame still runs what the last step changed
     glFinish();
@@ -146,6 +154,22 @@ std::string withoutFireballs(const std::string& sceneFile, const fs::path& dir) 
     Json j = Json::parse(slurp(sceneFile));
     j["fireballs"] = Json::array();
     const fs::path out = dir / "cornell-no-fireballs.json";
+    std::ofstream(out) << j.dump(2);
+    return out.string();
+}
+
+// The scene with its tumblers upright (they fall asleep after half a second at rest), no
+// fireballs and, with `oneMarble`, a single marble bouncing in place in a free corner
+// (elastic, frictionless: it never stops): what a scene where almost nothing moves costs.
+std::string restingScene(const std::string& sceneFile, const fs::path& dir, bool oneMarble) {
+    Json j = Json::parse(slurp(sceneFile));
+    for (auto& t : j["tumblers"]) t["tilt"] = Json::array({0.0, 0.0});
+    j["fireballs"] = Json::array();
+    j["marbles"] = Json::array();
+    if (oneMarble)
+        j["marbles"].push_back({{"position", {0.85, 0.2, -0.85}}, {"velocity", {0.0, 0.0, 0.0}}, {"radius", 0.05},
+                                {"color", {0.9, 0.9, 0.95}}});
+    const fs::path out = dir / (oneMarble ? "cornell-one-marble.json" : "cornell-asleep.json");
     std::ofstream(out) << j.dump(2);
     return out.string();
 }
@@ -254,11 +278,15 @@ int main(int argc, char** argv) {
         return 1;
     }
     const std::string pipeline = slurp(o.pipeline);
-    std::vector<Situation> situations = {{"moving", pipeline, o.scene, false}, {"paused", pipeline, o.scene, true}};
+    std::vector<Situation> situations = {{"moving", pipeline, o.scene, false},
+                                           {"paused", pipeline, o.scene, true, 0.0, true}};
     if (!overhead) {
         situations.push_back({"moving, no fireballs", pipeline, withoutFireballs(o.scene, args.outDir), false});
         situations.push_back({"moving, bloom culled", editedPipeline(pipeline, true, false), o.scene, false});
         situations.push_back({"moving, bloom disabled", editedPipeline(pipeline, false, true), o.scene, false});
+        situations.push_back({"asleep (tumblers at rest, no balls)", pipeline, restingScene(o.scene, args.outDir, false), false, 1.0, true});
+        situations.push_back(
+            {"one marble moving, the rest asleep", pipeline, restingScene(o.scene, args.outDir, true), false, 1.0});
     }
     const std::vector<Outcome> outcomes = measureRounds(app, situations, args);
 
