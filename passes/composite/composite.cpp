@@ -144,7 +144,7 @@ private:
     // at 512²), rebuilt when the lamp, the grid's size or its shader changed. False when
     // the pass failed.
     bool buildLampField(kiln::PassContext& ctx) {
-        GLuint builder = ctx.program({.stages = {"composite/lamp_field.comp"},
+        GLuint builder = ctx.program({.stages = {"common/lamp_field.comp"},
                                       .defines = {{"KILN_LAMP_SAMPLES", std::to_string(ctx.getInt("lamp_samples"))}}});
         if (!builder) return false;
         const int side = ctx.getInt("lamp_field_size");

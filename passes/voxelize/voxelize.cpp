@@ -68,6 +68,8 @@ public:
                      .doc = "xyz = the surfaces' mean unit normal (shorter where they disagree), a = occupancy"});
         for (const Sum& sum : kSums)
             d.internal({.name = sum.internal, .kind = TextureKind::Color3D, .format = Format::R32UI, .size = cube});
+        d.internal({.name = "lamp_field", .format = Format::RG16F, .size = SizeRule::fixed(kLampFieldSide, kLampFieldSide),
+                    .doc = "lamp_model field: the lamp's vector irradiance over (distance from its axis, height)"});
         d.param(intChoiceParam("resolution", 64, {32, 64, 128}, "voxels per side over [-1,1]^3"))
             .param(boolParam("conservative", true, "enlarge triangles by half a voxel (no holes from thin triangles)"))
             .param(boolParam("marbles", false, "voxelize the marbles too (the course design leaves them out)"))
@@ -90,9 +92,11 @@ public:
             .param(floatParam("lamp_emission", 0.0f, 0.0, 1.0,
                               "scale of the lamp dome's own emission in the voxels (its light already arrives "
                               "through composite's direct term: 1 counts it twice)"))
-            .param(enumParam("lamp_model", "contour", {"contour", "points"},
+            .param(enumParam("lamp_model", "contour", {"contour", "points", "field"},
                              "the lamp's irradiance on voxelized surfaces (shaders/common/light.glsl): its "
-                             "silhouette's contour integral (16 vertices), or 32 quadrature points over the cap"))
+                             "silhouette's contour integral (16 vertices), 32 quadrature points over the cap, or "
+                             "one lookup in its vector irradiance on a 256² axisymmetric grid (the `lamp_field` "
+                             "internal, built when the lamp changes; shaders/common/lamp_field.comp)"))
             .param(floatParam("shadow_bias", 0.002f, 0.0, 0.05, "depth bias of the (hard) shadow test"));
         d.reads = kSceneStatic | kSceneBodies | kSceneParticles | kSceneLight;
         return d;
@@ -101,8 +105,10 @@ public:
     void execute(kiln::PassContext& ctx) override {
         // 16 silhouette vertices (within 0.8 % of the exact irradiance; tests/gi/test_lamp.cpp)
         // or the old 32 quadrature points.
-        const bool contour = ctx.getEnum("lamp_model") == "contour";
-        const kiln::Defines lamp = {{"KILN_LAMP_CONTOUR", contour ? "1" : "0"}, {"KILN_LAMP_SAMPLES", contour ? "16" : "32"}};
+        const bool contour = ctx.getEnum("lamp_model") == "contour", field = ctx.getEnum("lamp_model") == "field";
+        const kiln::Defines lamp = {{"KILN_LAMP_CONTOUR", contour ? "1" : "0"},
+                                    {"KILN_LAMP_SAMPLES", contour || field ? "16" : "32"},
+                                    {"KILN_LAMP_FIELD", field ? "1" : "0"}};
         GLuint raster = ctx.program({.stages = {"voxelize/voxelize.vert", "voxelize/voxelize.geom", "voxelize/voxelize.frag"},
                                      .defines = lamp});
         GLuint resolve = ctx.program({.stages = {"voxelize/resolve.comp"}});
@@ -111,6 +117,7 @@ public:
         const bool splatFireballs = ctx.getEnum("fireball_mode") == "splat";
         GLuint splatter = splatParticles || splatFireballs ? ctx.program({.stages = {"voxelize/splat.comp"}, .defines = lamp}) : 0;
         if (!raster || !resolve || ((splatParticles || splatFireballs) && !splatter)) return;
+        if (field && !buildLampField(ctx)) return;
         const kiln::TextureRef& out = ctx.output("radiance");
         const int res = out.width;
 
@@ -141,6 +148,7 @@ private:
         glUniform1f(glGetUniformLocation(raster, "u_conservative"), ctx.getBool("conservative") ? 1.0f : 0.0f);
         glUniform1f(glGetUniformLocation(raster, "u_shadowBias"), ctx.getFloat("shadow_bias"));
         kiln::gl::bindTexture(raster, "u_shadowMap", ctx.input("shadow_map").id);
+        kiln::gl::bindTexture(raster, "u_lampField", ctx.internal("lamp_field").id);  // field only
         bindSums(ctx, raster, GL_READ_WRITE);
         uint32_t cats = kiln::kSceneBox | kiln::kSceneTumblers;
         if (rasterParticles) cats |= kiln::kSceneParticles;
@@ -175,6 +183,7 @@ private:
         if (count == 0) return true;
         glUseProgram(splatter);
         kiln::gl::bindTexture(splatter, "u_shadowMap", ctx.input("shadow_map").id);
+        kiln::gl::bindTexture(splatter, "u_lampField", ctx.internal("lamp_field").id);  // field only
         bindSums(ctx, splatter, GL_READ_WRITE);
         glUniform1i(glGetUniformLocation(splatter, "u_res"), res);
         glUniform1f(glGetUniformLocation(splatter, "u_shadowBias"), ctx.getFloat("shadow_bias"));
@@ -214,6 +223,30 @@ private:
             kiln::gl::bindImage(program, sum.image, ctx.internal(sum.internal).id, 0, true, access,
                                 std::string_view(sum.internal).starts_with("normal") ? GL_R32I : GL_R32UI);
     }
+
+    // lamp_model field: the lamp's vector irradiance on its grid (the same builder as
+    // composite's), rebuilt when the lamp, the texture or the builder changed. False when
+    // the pass failed.
+    static constexpr int kLampFieldSide = 256;
+    bool buildLampField(kiln::PassContext& ctx) {
+        GLuint builder = ctx.program({.stages = {"common/lamp_field.comp"}, .defines = {{"KILN_LAMP_SAMPLES", "16"}}});
+        if (!builder) return false;
+        const kiln::TextureRef& field = ctx.internal("lamp_field");
+        const FieldKey key{ctx.scene().version(kiln::kSceneLight), field.id, builder};
+        if (key == builtField_) return true;
+        glUseProgram(builder);
+        kiln::gl::bindImage(builder, "u_field", field.id, 0, false, GL_WRITE_ONLY, GL_RG16F);
+        glDispatchCompute(GLuint((field.width + 7) / 8), GLuint((field.height + 7) / 8), 1);
+        glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
+        builtField_ = key;
+        return true;
+    }
+    struct FieldKey {
+        uint64_t lightVersion = 0;
+        GLuint texture = 0, program = 0;
+        bool operator==(const FieldKey&) const = default;
+    };
+    FieldKey builtField_;
 
     kiln::gl::FramebufferHandle fbo_;  // attachment-less; a GL cache only (a reload makes a new one)
     int fboSize_ = 0;

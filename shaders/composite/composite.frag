@@ -6,7 +6,7 @@
 #include "common/frame.glsl"
 #include "common/light.glsl"
 #include "common/shadow.glsl"
-#include "lamp_field.glsl"
+#include "common/lamp_field.glsl"
 #include "common/tonemap.glsl"
 
 in vec2 v_uv;
@@ -31,7 +31,7 @@ uniform int u_tonemap;   // kTonemapAces, kTonemapReinhard, kTonemapClamp
 uniform float u_shadowBias;
 uniform float u_indirectStrength;
 #if KILN_LAMP_FIELD
-layout(binding = 8) uniform sampler2D u_lampField;  // F on the lamp's axisymmetric grid (composite/lamp_field.comp)
+layout(binding = 8) uniform sampler2D u_lampField;  // F on the lamp's axisymmetric grid (common/lamp_field.comp)
 #endif
 uniform float u_lampNearField;  // lamp_model traced or field: metres from the dome evaluated per pixel
 
@@ -128,7 +128,7 @@ void main() {
         // traced: cone_trace's `lamp`, the projected solid angle where it traced,
         // upsampled. field: from the lamp's vector irradiance F on a grid, n·F (exact up
         // to the grid where the whole emitter is above the surface's horizon) or, where
-        // the horizon cuts it, the clipped form of the ball F describes (lamp_field.glsl).
+        // the horizon cuts it, the clipped form of the ball F describes (common/lamp_field.glsl).
         // Within u_lampNearField of the dome both change faster than their samples:
         // evaluated here, by the variant composite.cpp draws over the near field's
         // screen rectangle only (on llvmpipe the contour's mere presence in the shader

@@ -2,8 +2,13 @@
 // (voxelize.frag) and the splatted spheres (splat.comp): the lamp's diffuse light
 // (common/light.glsl) with one hard shadow-map test, taken one voxel off the surface
 // along its normal (against acne). Emission is the caller's to add.
-// Needs common/light.glsl and common/shadow.glsl; binds the shadow map at texture unit 0.
+// Needs common/light.glsl and common/shadow.glsl; binds the shadow map at texture unit 0
+// and, with KILN_LAMP_FIELD, the lamp's field (common/lamp_field.comp) at unit 1.
 layout(binding = 0) uniform sampler2D u_shadowMap;
+#if KILN_LAMP_FIELD
+#include "common/lamp_field.glsl"
+layout(binding = 1) uniform sampler2D u_lampField;
+#endif
 uniform int u_res;          // voxels per side
 uniform float u_shadowBias;
 
@@ -12,7 +17,12 @@ vec3 lampReflected(vec3 albedo, vec3 p, vec3 n) {
 #if KILN_HAS_SHADOW_MAP
     vis = shadowHard(u_shadowMap, p + n * (2.0 / float(u_res)), u_shadowBias);
 #endif
-    return albedo / 3.14159265 * lampLight(p, n) * vis;
+#if KILN_LAMP_FIELD
+    vec3 irradiance = u_lightColor.rgb * lampFieldSolidAngle(lampFieldAt(u_lampField, p), p, n);
+#else
+    vec3 irradiance = lampLight(p, n);
+#endif
+    return albedo / 3.14159265 * irradiance * vis;
 }
 
 // A sphere of radius r voxelized on voxels of side h (rasterized conservatively, or

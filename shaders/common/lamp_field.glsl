@@ -1,6 +1,7 @@
-// The lamp's vector irradiance on composite's axisymmetric grid (lamp_field.comp builds
-// it, composite.frag reads it): where the grid's nodes lie and how a point finds them.
-// Needs common/frame.glsl (u_lightPos).
+// The lamp's vector irradiance on an axisymmetric grid (common/lamp_field.comp builds
+// it; composite and voxelize, lamp_model `field`, read it): where the grid's nodes lie,
+// how a point finds them, and the projected solid angle from what it reads.
+// Needs common/frame.glsl (u_lightPos) and common/light.glsl (kCeilingY).
 
 // ρ of the grid's last column: the box's vertical edge farthest from the lamp's axis.
 float lampFieldRadius() { return length(vec2(1.0) + abs(u_lightPos.xz)); }

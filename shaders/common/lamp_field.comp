@@ -1,5 +1,5 @@
 #version 450 core
-// composite's lamp_model `field`: the lamp's vector irradiance ÷ its radiance
+// lamp_model `field` (composite, voxelize): the lamp's vector irradiance ÷ its radiance
 // (common/light.glsl lampVector), stored on a 2D grid. The lamp is a ball cut by the
 // horizontal ceiling, so it is symmetric about the vertical line through its centre,
 // and so is F: at a point ρ from that axis and at height y, F = F_ρ(ρ, y) ρ̂ + F_y(ρ, y) ŷ.
@@ -8,7 +8,7 @@
 // One bilinear lookup a pixel where a 3D grid took a trilinear one, and N² nodes
 // instead of N³. Built when the lamp changes.
 #include "common/light.glsl"
-#include "lamp_field.glsl"
+#include "common/lamp_field.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(rg16f, binding = 0) uniform writeonly image2D u_field;
