@@ -69,11 +69,14 @@ glm::vec2 TextureViewer::texelAt(glm::vec2 canvasPixel, glm::vec2 canvasSize, co
 
 bool TextureViewer::reload(const ShaderLibrary& shaders, std::string& error) {
     ProgramBuild b = buildProgram(shaders, {{"common/fullscreen.vert", "host/display.frag"}, {}, "kiln.display"});
-    if (!b.ok()) {
-        error = b.errorText();
+    ProgramBuild plain = buildProgram(
+        shaders, {{"common/fullscreen.vert", "host/display.frag"}, {{"KILN_DISPLAY_PLAIN", "1"}}, "kiln.display.plain"});
+    if (!b.ok() || !plain.ok()) {
+        error = (b.ok() ? plain : b).errorText();
         return false;
     }
     program_ = std::move(b.program);
+    plainProgram_ = std::move(plain.program);
     return true;
 }
 
@@ -90,15 +93,17 @@ void TextureViewer::draw(const TextureRef& t, float depthNear, float depthFar, c
     const glm::ivec2 plane = planeSize(t, mip, s.axis);
     const glm::vec2 canvas(rect.z, rect.w);
     glViewport(rect.x, rect.y, rect.z, rect.w);
-    glUseProgram(program_.id());
+    const bool linear = depthPlanesApply(t, depthNear, depthFar, s);
+    const bool plain = !is3D && !isUint && s.channel == 0 && !s.tonemap && !s.checker && legendPx == 0 && !linear &&
+                       mip == 0;
+    const GLuint p = plain ? plainProgram_.id() : program_.id();
+    glUseProgram(p);
     glBindTextureUnit((isUint ? 2 : 0) + (is3D ? 1 : 0), t.id);
-    const GLuint p = program_.id();
     auto loc = [&](const char* n) { return glGetUniformLocation(p, n); };
     glUniform1i(loc("u_kind"), (isUint ? 2 : 0) + (is3D ? 1 : 0));
     glUniform1i(loc("u_channel"), s.channel);
     glUniform2f(loc("u_range"), s.rangeMin, s.rangeMax);
     glUniform1i(loc("u_falseColor"), s.falseColor);
-    const bool linear = depthPlanesApply(t, depthNear, depthFar, s);
     glUniform2f(loc("u_depthPlanes"), linear ? depthNear : 0.0f, linear ? depthFar : 0.0f);
     glUniform1i(loc("u_mip"), mip);
     glUniform1i(loc("u_slice"), clampedSlice(t, s, mip));

@@ -102,6 +102,7 @@ private:
     void readoutAndHistogram(const run::NamedTexture& nt, const std::string& name);
 
     gl::ProgramHandle program_;
+    gl::ProgramHandle plainProgram_;  // KILN_DISPLAY_PLAIN: a float 2D texture as it is
     gl::VertexArrayHandle vao_;
     gl::Texture canvas_;           // the ImGui window's image, redrawn every frame
     gl::FramebufferHandle canvasFbo_;

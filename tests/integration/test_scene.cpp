@@ -6,12 +6,14 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 
 #include <glm/gtc/matrix_transform.hpp>
 #include <nlohmann/json.hpp>
 
 #include "app/app.hpp"
 #include "app/pixel_trace.hpp"
+#include "app/texture_viewer.hpp"
 #include "kiln/image_io.hpp"
 #include "support/golden.hpp"
 #include "scene/scene_renderer.hpp"
@@ -128,6 +130,54 @@ TEST_CASE("a scene at rest costs nothing once settled, though its clock runs", "
         INFO(r.id);
         CHECK(r.state == "skipped");
     }
+}
+
+TEST_CASE("the window's plain image display draws what the general texture viewer draws", "[scene][gl]") {
+    // The window shows the graph's output through the viewer's plain variant
+    // (KILN_DISPLAY_PLAIN in shaders/host/display.frag: the general shader's branches on
+    // uniforms cost llvmpipe 9.9 ms a 720² frame). The general shader, given a setting
+    // that changes nothing here (a checkerboard under alpha 1), must draw the same
+    // pixels: the texels scaled and clamped to the range, magenta for a NaN, and the
+    // backdrop around the texture.
+    Rig rig({}, 16);
+    app::TextureViewer viewer;
+    std::string error;
+    REQUIRE(viewer.init(rig.app.runtime().shaders(), error));
+    constexpr int kSide = 8, kCanvasW = 40, kCanvasH = 24;
+    std::vector<float> texels(kSide * kSide * 4);
+    for (int i = 0; i < kSide * kSide; ++i)
+        for (int c = 0; c < 3; ++c) texels[size_t(i * 4 + c)] = 0.05f * float(i % 23) + 0.3f * float(c);  // some above 1
+    for (int i = 0; i < kSide * kSide; ++i) texels[size_t(i * 4 + 3)] = 1.0f;
+    texels[size_t((5 * kSide + 3) * 4 + 1)] = std::numeric_limits<float>::quiet_NaN();
+    gl::Texture texture = gl::Texture::create(GL_TEXTURE_2D, GL_RGBA32F, kSide, kSide, 1, 1, "test.viewer");
+    glTextureSubImage2D(texture.id(), 0, 0, 0, kSide, kSide, GL_RGBA, GL_FLOAT, texels.data());
+    const TextureRef ref{texture.id(), GL_TEXTURE_2D, GL_RGBA32F, kSide, kSide, 1, 1, true};
+    gl::Texture target = gl::Texture::create(GL_TEXTURE_2D, GL_RGBA8, kCanvasW, kCanvasH, 1, 1, "test.viewer.canvas");
+    gl::FramebufferHandle fbo = gl::createFramebuffer();
+    glNamedFramebufferTexture(fbo.id(), GL_COLOR_ATTACHMENT0, target.id(), 0);
+    auto drawn = [&](const app::ViewSettings& s) {
+        glBindFramebuffer(GL_FRAMEBUFFER, fbo.id());
+        viewer.draw(ref, 0.0f, 0.0f, s, glm::ivec4(0, 0, kCanvasW, kCanvasH));
+        std::vector<uint8_t> out(size_t(kCanvasW * kCanvasH * 4));
+        glReadPixels(0, 0, kCanvasW, kCanvasH, GL_RGBA, GL_UNSIGNED_BYTE, out.data());
+        glBindFramebuffer(GL_FRAMEBUFFER, 0);
+        return out;
+    };
+    app::ViewSettings plain;
+    plain.zoom = 2.0f;  // 16×16 pixels of texture in a 40×24 canvas: backdrop on every side
+    app::ViewSettings general = plain;
+    general.checker = true;
+    const std::vector<uint8_t> a = drawn(plain), b = drawn(general);
+    CHECK(a == b);
+    auto at = [&](int x, int y) { return glm::ivec3(a[size_t((y * kCanvasW + x) * 4)], a[size_t((y * kCanvasW + x) * 4 + 1)],
+                                                    a[size_t((y * kCanvasW + x) * 4 + 2)]); };
+    CHECK(at(0, 0) == glm::ivec3(20, 20, 23));                 // the backdrop, 0.08 / 0.09
+    CHECK(at(12 + 2 * 3, 4 + 2 * 5) == glm::ivec3(255, 0, 255));  // texel (3, 5): NaN
+    // Texel (0, 0) holds 0, 0.3, 0.6: 0, 76.5, 153 in 8 bits (±1: the conversion's rounding).
+    const glm::ivec3 first = at(12, 4);
+    INFO(first.x << " " << first.y << " " << first.z);
+    CHECK(glm::all(glm::lessThanEqual(glm::abs(first - glm::ivec3(0, 77, 153)), glm::ivec3(1))));
+    CHECK(at(12 + 2 * 6, 4 + 2 * 2) == glm::ivec3(255));  // texel (6, 2): 1.1, 1.4, 1.7, clamped
 }
 
 TEST_CASE("the ray through a tumbler's projected centre picks that tumbler", "[scene][gl]") {
