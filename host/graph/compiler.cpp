@@ -84,12 +84,15 @@ void checkTexture(const char* what, const TextureDecl& t, const PassDeclaration&
             break;
         case SizeRule::Mode::RelativeOverParam: checkRelative(); [[fallthrough]];
         case SizeRule::Mode::FromParam: {
-            const ParamDecl* side = declaredParam(d, t.size.source);
-            if (!side)
-                problems.push_back(name + " takes its size from unknown parameter " + q(t.size.source));
-            else if (side->type != ParamType::Int)
-                problems.push_back(name + " takes its size from parameter " + q(t.size.source) + ", which is a " +
-                                   toString(side->type) + ", not an int");
+            for (const std::string* source : {&t.size.source, &t.size.capSource}) {
+                if (source->empty() && source == &t.size.capSource) continue;  // the cap is optional
+                const ParamDecl* side = declaredParam(d, *source);
+                if (!side)
+                    problems.push_back(name + " takes its size from unknown parameter " + q(*source));
+                else if (side->type != ParamType::Int)
+                    problems.push_back(name + " takes its size from parameter " + q(*source) + ", which is a " +
+                                       toString(side->type) + ", not an int");
+            }
             break;
         }
         case SizeRule::Mode::FromInput:
@@ -171,7 +174,9 @@ std::string textureKey(const TextureDecl& t) {
         case SizeRule::Mode::FromInput:
             s += "input:" + t.size.source + "*" + num(t.size.scale) + "x" + std::to_string(t.size.tiles);
             break;
-        case SizeRule::Mode::RelativeOverParam: s += "rel" + num(t.size.scale) + "/" + t.size.source; break;
+        case SizeRule::Mode::RelativeOverParam:
+            s += "rel" + num(t.size.scale) + "/" + t.size.source + "^" + t.size.capSource;
+            break;
     }
     return s + ":mips" + std::to_string(t.mips);
 }

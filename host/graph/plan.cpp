@@ -145,7 +145,8 @@ Extent resolveSize(const TextureDecl& t, int outW, int outH, const ResolvedParam
         }
         case SizeRule::Mode::RelativeOverParam: {
             const int* divisor = params.get<int>(t.size.source);
-            const double scale = double(t.size.scale) / std::max(1, divisor ? *divisor : 1);
+            const int* cap = t.size.capSource.empty() ? nullptr : params.get<int>(t.size.capSource);
+            const double scale = double(t.size.scale) / sizeDivisor(divisor ? *divisor : 1, cap ? *cap : 0, outW, outH);
             auto side = [&](int out) { return static_cast<int>(std::clamp<long>(std::lround(scale * out), 1, 1L << 30)); };
             e.w = side(outW);
             e.h = side(outH);
@@ -197,10 +198,13 @@ std::string describeSize(const TextureDecl& t, const ResolvedParams& params) {
         }
         case SizeRule::Mode::RelativeOverParam: {
             const int* divisor = params.get<int>(t.size.source);
-            char buf[64];
+            char buf[160];
             std::snprintf(buf, sizeof buf, "%gx / %s (%d)", static_cast<double>(t.size.scale), t.size.source.c_str(),
                           divisor ? *divisor : 1);
-            return buf;
+            std::string d = buf;
+            if (const int* cap = t.size.capSource.empty() ? nullptr : params.get<int>(t.size.capSource); cap && *cap > 0)
+                d += ", at most " + std::to_string(*cap) + " across (" + t.size.capSource + ")";
+            return d;
         }
         case SizeRule::Mode::FromParam: {
             const int* side = params.get<int>(t.size.source);

@@ -115,7 +115,7 @@ bool Runtime::setParam(const std::string& passId, const std::string& name, const
         for (const auto* list : {&planned.decl.outputs, &planned.decl.internals})
             for (const TextureDecl& t : *list)
                 if (((t.size.mode == SizeRule::Mode::FromParam || t.size.mode == SizeRule::Mode::RelativeOverParam) &&
-                     t.size.source == name) ||
+                     (t.size.source == name || t.size.capSource == name)) ||
                     t.producedWhen.param == name)
                     return true;
         return false;

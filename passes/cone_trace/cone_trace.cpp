@@ -24,6 +24,9 @@
 // the box's axis-aligned walls) in its hemisphere, weighted by cos θ; `cones` must be 6.
 // Each step is one fetch from chains voxel_mip blended per direction, not three:
 // the anisotropic result at the cost of an isotropic lookup.
+// trace_samples N caps the samples across the picture's longer side: the stride is then
+// ⌈longer side ÷ N⌉ where that exceeds trace_stride (any integer; the shaders take it as
+// a uniform).
 // trace_stride 2 or 4: trace one pixel in every 2×2 (4×4) block into the internal
 // `samples`, with the traced surface's plane in `planes`, then a depth/normal-aware
 // upsample writes `indirect`. output_divisor 2: `indirect` is half the picture's size
@@ -143,19 +146,19 @@ public:
             .output({.name = "indirect", .format = Format::RGBA16F, .size = SizeRule::relativeOverParam("output_divisor"),
                      .doc = "rgb = indirect irradiance / π, a = AO (or with `lamp`: the lamp's projected solid "
                             "angle); the output's size ÷ output_divisor"})
-            .internal({.name = "samples", .format = Format::RGBA16F, .size = SizeRule::relativeOverParam("trace_stride"),
+            .internal({.name = "samples", .format = Format::RGBA16F, .size = SizeRule::relativeOverParam("trace_stride", 1.0f, "trace_samples"),
                        .doc = "trace_stride > 1: the traced samples"})
-            .internal({.name = "planes", .format = Format::RGBA16F, .size = SizeRule::relativeOverParam("trace_stride"),
+            .internal({.name = "planes", .format = Format::RGBA16F, .size = SizeRule::relativeOverParam("trace_stride", 1.0f, "trace_samples"),
                        .doc = "trace_stride > 1: each sample's surface, xyz = normal, w = n·p (0,0,0 off geometry)"})
-            .internal({.name = "ages", .format = Format::RGBA32F, .size = SizeRule::relativeOverParam("trace_stride"),
+            .internal({.name = "ages", .format = Format::RGBA32F, .size = SizeRule::relativeOverParam("trace_stride", 1.0f, "trace_samples"),
                        .doc = "reuse_frames > 1: x = frames each sample's light has been kept (0: traced this frame), "
                               "yzw = the world point it was traced at"})
-            .internal({.name = "history", .format = Format::RGBA16F, .size = SizeRule::relativeOverParam("trace_stride"),
+            .internal({.name = "history", .format = Format::RGBA16F, .size = SizeRule::relativeOverParam("trace_stride", 1.0f, "trace_samples"),
                        .doc = "reuse_frames > 1: last frame's samples"})
             .internal({.name = "history_planes", .format = Format::RGBA16F,
-                       .size = SizeRule::relativeOverParam("trace_stride"), .doc = "reuse_frames > 1: their surfaces"})
+                       .size = SizeRule::relativeOverParam("trace_stride", 1.0f, "trace_samples"), .doc = "reuse_frames > 1: their surfaces"})
             .internal({.name = "history_ages", .format = Format::RGBA32F,
-                       .size = SizeRule::relativeOverParam("trace_stride"), .doc = "reuse_frames > 1: their ages and points"})
+                       .size = SizeRule::relativeOverParam("trace_stride", 1.0f, "trace_samples"), .doc = "reuse_frames > 1: their ages and points"})
             .param(intChoiceParam("cones", 6, {1, 5, 6, 9, 16},
                                   "diffuse cones per pixel, around the normal (with fixed_cones bound: 6, the fixed set)"))
             .param(floatParam("aperture", 60.0f, 5.0, 150.0, "cone opening angle, degrees"))
@@ -167,9 +170,11 @@ public:
             .param(floatParam("diameter_offset", 0.5f, 0.0, 2.0,
                               "each sample pushed off the surface by this × its diameter (against self-occlusion)"))
             .param(intChoiceParam("trace_stride", 1, {1, 2, 4, 8},
-                                  "trace one pixel per N×N block and upsample (depth/normal aware); 1 = every pixel. "
-                                  "A fraction of the picture: at 720² 8 traces 90² pixels (cone_trace 13.4 -> 6.2 ms), "
-                                  "off every-pixel tracing by less than 4 is at 256² (RMS 0.0085 against 0.0102)"))
+                                  "trace one pixel per N×N block and upsample (depth/normal aware); 1 = every pixel"))
+            .param(intParam("trace_samples", 0, 0, 4096,
+                            "at most this many traced samples across the picture's longer side: the stride grows "
+                            "with the picture beyond trace_stride (0: no cap). Indirect light varies over the scene, "
+                            "not over pixels: a large picture needs no more samples of it than a small one"))
             .param(intChoiceParam("output_divisor", 1, {1, 2},
                                   "2: upsample to half resolution; composite's bilinear lookup does the last 2×"))
             .param(floatParam("upsample_tolerance", 0.02f, 0.001, 1.0, "plane distance (world) that halves a sample's weight"))
@@ -199,7 +204,10 @@ public:
         kiln::Defines defines = schedule(ctx, voxels.width);
         defines.emplace_back("KILN_LAMP_IN_ALPHA", ctx.getBool("lamp") ? "1" : "0");
         defines.emplace_back("KILN_LAMP_SAMPLES", "16");  // silhouette vertices: within 0.8 % (tests/gi/test_lamp.cpp)
-        const int stride = ctx.getInt("trace_stride");
+        // The host sized `samples` by the same rule (kiln::sizeDivisor); normal is the output's size.
+        const kiln::TextureRef& normal = ctx.input("normal");
+        const int stride = kiln::sizeDivisor(ctx.getInt("trace_stride"), ctx.getInt("trace_samples"), normal.width,
+                                             normal.height);
         // An `indirect` pixel covers `divisor` G-buffer texels per side. A trace no
         // sparser than that goes straight into it (one texel per pixel); a sparser one
         // goes into `samples` and is upsampled.

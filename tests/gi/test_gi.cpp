@@ -801,7 +801,7 @@ TEST_CASE("default pipeline: no NaN or Inf in any texture (every level of the vo
     CHECK(scanned > 10);
 }
 
-TEST_CASE("cone_trace trace_stride: the depth/normal-aware upsample stays close to tracing every pixel",
+TEST_CASE("cone_trace trace_stride and trace_samples: the depth/normal-aware upsample stays close to tracing every pixel",
           "[gi][cone]") {
     // Same frame traced at every pixel, at strides 2 and 4, and at stride 4 upsampled
     // to a half-size output (output_divisor 2, read bilinearly at each pixel centre as
@@ -812,11 +812,19 @@ TEST_CASE("cone_trace trace_stride: the depth/normal-aware upsample stays close 
     // samples of the matching surface from 2 (4) pixels away, or takes the nearest
     // sample when none matches, and where the last bilinear step, blind to geometry,
     // mixes the two sides of an edge over one pixel.
-    const char* const params[] = {R"({"trace_stride": 1})", R"({"trace_stride": 2})", R"({"trace_stride": 4})",
-                                  R"({"trace_stride": 4, "output_divisor": 2})"};
-    FloatImage out[4];
+    // trace_samples caps the samples across: 40 at 128² raises stride 2 to ⌈128/40⌉ = 4,
+    // the stride-4 trace exactly; 43 raises 1 to 3, a stride no choice offers, which must
+    // land between 2 and 4 (measured 7.9 %).
+    const char* const params[] = {R"({"trace_stride": 1})",
+                                  R"({"trace_stride": 2})",
+                                  R"({"trace_stride": 4})",
+                                  R"({"trace_stride": 4, "output_divisor": 2})",
+                                  R"({"trace_stride": 2, "trace_samples": 40})",
+                                  R"({"trace_stride": 1, "trace_samples": 43})"};
+    FloatImage out[6];
     FloatImage normal;
-    for (int i = 0; i < 4; ++i) {
+    int samplesAcross[6] = {};
+    for (int i = 0; i < 6; ++i) {
         Rig rig("", 128);
         std::string text = seedPipeline("aniso", 32);
         const std::string key = R"("voxels": "voxel_mip.iso", "aniso": "voxel_mip.aniso"})";
@@ -826,8 +834,15 @@ TEST_CASE("cone_trace trace_stride: the depth/normal-aware upsample stays close 
         rig.checkNoErrors();
         out[i] = rig.image("cone_trace", "indirect");
         normal = rig.image("gbuffer", "normal");
+        if (i >= 4) samplesAcross[i] = rig.image("cone_trace", "samples").width;
     }
     REQUIRE(out[3].width == 64);
+    CHECK(samplesAcross[4] == 32);
+    CHECK(samplesAcross[5] == 43);
+    double capDiff = 0;  // the capped stride-2 trace is the stride-4 one
+    for (int y = 0; y < 128; ++y)
+        for (int x = 0; x < 128; ++x) capDiff = std::max(capDiff, double(std::abs(luminance(out[4].at(x, y)) - luminance(out[2].at(x, y)))));
+    CHECK(capDiff < 1e-6);
     // Bilinear lookup at full-resolution pixel (x, y) of an image of any size.
     auto lookup = [](const FloatImage& img, int x, int y) {
         const double fx = (x + 0.5) * img.width / 128.0 - 0.5, fy = (y + 0.5) * img.height / 128.0 - 0.5;
@@ -852,8 +867,11 @@ TEST_CASE("cone_trace trace_stride: the depth/normal-aware upsample stays close 
         return std::sqrt(se / n) / (sum / n);
     };
     const double rel2 = relativeRmse(out[1]), rel4 = relativeRmse(out[2]), rel4half = relativeRmse(out[3]);
-    WARN("relative RMSE of the indirect luminance: stride 2 " << rel2 << ", stride 4 " << rel4
-                                                              << ", stride 4 to a half-size output " << rel4half);
+    const double rel3 = relativeRmse(out[5]);
+    WARN("relative RMSE of the indirect luminance: stride 2 " << rel2 << ", stride 3 (capped) " << rel3 << ", stride 4 "
+                                                              << rel4 << ", stride 4 to a half-size output " << rel4half);
+    CHECK(rel3 > rel2);
+    CHECK(rel3 < rel4);
     CHECK(rel2 < 0.10);
     CHECK(rel4 < 0.15);
     CHECK(rel4half < 0.18);

@@ -76,6 +76,11 @@ inline std::map<std::string, PassDeclaration> fakeModules() {
     m["float_divisor"]
         .output({"color", TextureKind::Color2D, Format::RGBA8, SizeRule::relativeOverParam("stride"), 1, ""})
         .param(floatParam("stride", 2.0f, 1.0, 4.0));
+    // A divided-size output capped by a parameter that is not there.
+    m["capped_by_nothing"]
+        .output({"color", TextureKind::Color2D, Format::RGBA8, SizeRule::relativeOverParam("stride", 1.0f, "cpa"), 1, ""})
+        .param(intParam("stride", 2, 1, 4))
+        .param(intParam("cap", 64, 0, 512));
     m["divided_volume"]
         .output({"color", TextureKind::Color3D, Format::RGBA8, SizeRule::relativeOverParam("stride"), 1, ""})
         .param(intParam("stride", 2, 1, 4));

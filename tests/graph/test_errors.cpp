@@ -248,6 +248,9 @@ TEST_CASE("output size from a bad parameter is reported against the module", "[e
     e = errorsOf(R"({ "output": "b.color", "passes": [ { "id": "b", "module": "float_divisor" } ] })");
     CHECK_THAT(e, Contains("module \"float_divisor\" declares output \"color\" takes its size from "
                            "parameter \"stride\", which is a float, not an int"));
+    e = errorsOf(R"({ "output": "b.color", "passes": [ { "id": "b", "module": "capped_by_nothing" } ] })");
+    CHECK_THAT(e, Contains("module \"capped_by_nothing\" declares output \"color\" takes its size from "
+                           "unknown parameter \"cpa\""));
     e = errorsOf(R"({ "output": "b.color", "passes": [ { "id": "b", "module": "divided_volume" } ] })");
     CHECK_THAT(e, Contains("module \"divided_volume\" declares output \"color\" is 3D but sized relative to the (2D) output"));
     e = errorsOf(R"({ "output": "b.color", "passes": [ { "id": "b", "module": "produced_when_wrong" } ] })");

@@ -181,6 +181,16 @@ TEST_CASE("resolveSize", "[plan][size]") {
     CHECK(resolveSize(t, 1280, 720, params) == Extent{640, 360, 1});
     t.size = SizeRule::relativeOverParam("missing");  // the compiler reports it; sizes stay sane
     CHECK(resolveSize(t, 1280, 720, params) == Extent{1280, 720, 1});
+    // Capped: at most `cap` texels across the longer side, the divisor raised to ⌈1280/cap⌉.
+    params.values.push_back({"cap", 100});
+    t.size = SizeRule::relativeOverParam("stride", 1.0f, "cap");
+    CHECK(sizeDivisor(4, 100, 1280, 720) == 13);
+    CHECK(resolveSize(t, 1280, 720, params) == Extent{98, 55, 1});
+    CHECK(describeSize(t, params) == "1x / stride (4), at most 100 across (cap)");
+    CHECK(resolveSize(t, 256, 256, params) == Extent{64, 64, 1});  // stride 4 already gives fewer
+    CHECK(sizeDivisor(4, 0, 1280, 720) == 4);                       // cap 0: none
+    CHECK(sizeDivisor(0, 0, 1280, 720) == 1);
+    CHECK(sizeDivisor(1, 64, 128, 256) == 4);                       // the longer side, either axis
 }
 
 TEST_CASE("fromInput sizes follow the producer through the bindings", "[plan][size]") {

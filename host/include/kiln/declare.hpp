@@ -53,13 +53,16 @@ struct SizeRule {
                            // 1×1(×1) when an optional input is unbound); `tiles` such
                            // blocks side by side along x
         RelativeOverParam, // scale × the graph's output size ÷ the int parameter `source`
-                           // (2D; e.g. a trace at 1/stride of the picture)
+                           // (2D; e.g. a trace at 1/stride of the picture), the divisor
+                           // raised where `capSource` caps the samples across (sizeDivisor)
     };
     Mode mode = Mode::RelativeToOutput;
     float scale = 1.0f;
     int width = 0, height = 0, depth = 1;
     std::string source;  // FromParam: the int parameter; FromInput: the input slot
     int tiles = 1;
+    std::string capSource;  // RelativeOverParam: an int parameter, the most texels across
+                            // the longer side (≤ 0: no cap)
 
     static SizeRule relative(float s = 1.0f) { return {Mode::RelativeToOutput, s, 0, 0, 1, {}, 1}; }
     static SizeRule fixed(int w, int h, int d = 1) { return {Mode::Fixed, 1.0f, w, h, d, {}, 1}; }
@@ -69,10 +72,23 @@ struct SizeRule {
     static SizeRule fromInput(std::string slot, float scale = 1.0f, int tiles = 1) {
         return {Mode::FromInput, scale, 0, 0, 1, std::move(slot), tiles};
     }
-    static SizeRule relativeOverParam(std::string name, float scale = 1.0f) {
-        return {Mode::RelativeOverParam, scale, 0, 0, 1, std::move(name), 1};
+    static SizeRule relativeOverParam(std::string name, float scale = 1.0f, std::string cap = {}) {
+        return {Mode::RelativeOverParam, scale, 0, 0, 1, std::move(name), 1, std::move(cap)};
     }
 };
+
+// The divisor of a RelativeOverParam size at an outW × outH output: the parameter's
+// value, or, where a cap is given (> 0), at least ⌈longer side ÷ cap⌉, so no more than
+// about `cap` texels lie across however large the picture (a trace whose density is
+// set in samples across the view, not in a fraction of its pixels). A pass that reads
+// the divisor back (its stride) calls this with the same values the host sized by.
+inline int sizeDivisor(int divisor, int cap, int outW, int outH) {
+    divisor = divisor < 1 ? 1 : divisor;
+    if (cap <= 0) return divisor;
+    const int longer = outW > outH ? outW : outH;
+    const int capped = (longer + cap - 1) / cap;
+    return capped > divisor ? capped : divisor;
+}
 
 // Mip count 1 = no mips; kFullMipChain = down to 1×1(×1).
 inline constexpr int kFullMipChain = 0;
