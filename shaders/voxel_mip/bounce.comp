@@ -15,12 +15,30 @@
 // KILN_BOUNCE_STEP: 0 = gather and reflect (the above, into u_bounced); with feedback
 // (voxel_mip's `feedback`), 1 = gather only, kept as Ē per voxel for the next frame, and
 // 2 = no gather: L = L_0 + albedo · (that kept Ē), the frame's starting level 0.
+// 3 = list the blocks that hold a reflecting surface (their indices in GatherList, the
+// dispatch size of a 64-wide pass over them beside it) and write the kept gather of
+// every other block: nothing, what step 1 would have gathered there. Step 1 with
+// KILN_GATHER_LIST then runs over the list only: llvmpipe runs a compute shader's loop
+// for all 8 lanes of a SIMD vector while any one has work, and every row of 8 blocks
+// meets a side wall, so over the whole grid every block paid a surface's cones.
 // fixed_cones.glsl first: trace.glsl's voxels.glsl includes it only inside
 // `#if KILN_HAS_FIXED_CONES`, and a file is included once per stage.
 #include "common/fixed_cones.glsl"
 #include "cone_trace/trace.glsl"
 
+#if KILN_GATHER_LIST && KILN_BOUNCE_STEP == 1
+layout(local_size_x = 64) in;
+#else
 layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
+#endif
+#if KILN_GATHER_LIST
+// Filled by step 3, read by step 1; `dispatch` is glDispatchComputeIndirect's (x, y, z).
+layout(std430, binding = 2) buffer GatherList {
+    uint u_dispatch[3];
+    uint u_listed;
+    uint u_blocks[];  // x | y << 10 | z << 20
+};
+#endif
 layout(binding = 0) uniform sampler3D u_emitted;  // voxelize.radiance: direct light + emission
 layout(binding = 1) uniform sampler3D u_albedo;   // voxelize.albedo
 layout(binding = 4) uniform sampler3D u_normal;   // voxelize.normal
@@ -84,10 +102,34 @@ vec4 reflecting(ivec3 v, vec3 incoming) {
     return radiance;
 }
 
+#if KILN_BOUNCE_STEP == 3
 void main() {
+    ivec3 block = ivec3(gl_GlobalInvocationID);
+    if (any(greaterThanEqual(block * kBlock, ivec3(int(u_voxelRes))))) return;
+    bool surface = false;
+    for (int i = 0; i < kBlock * kBlock * kBlock; ++i) {
+        ivec3 v = voxelOf(block, i);
+        surface = surface || reflects(texelFetch(u_emitted, v, 0), texelFetch(u_albedo, v, 0).rgb);
+    }
+    if (surface) {
+        uint index = atomicAdd(u_listed, 1u);
+        u_blocks[index] = uint(block.x) | uint(block.y) << 10 | uint(block.z) << 20;
+        if (index % 64u == 0u) atomicAdd(u_dispatch[0], 1u);  // one more 64-wide group
+    } else {
+        for (int i = 0; i < kBlock * kBlock * kBlock; ++i) imageStore(u_bounced, voxelOf(block, i), vec4(0.0, 0.0, 0.0, 1.0));
+    }
+}
+#else
+void main() {
+#if KILN_GATHER_LIST && KILN_BOUNCE_STEP == 1
+    if (gl_GlobalInvocationID.x >= u_listed) return;
+    uint code = u_blocks[gl_GlobalInvocationID.x];
+    ivec3 block = ivec3(code & 1023u, (code >> 10) & 1023u, code >> 20);
+#else
     ivec3 block = ivec3(gl_GlobalInvocationID);
     int res = int(u_voxelRes);
     if (any(greaterThanEqual(block * kBlock, ivec3(res)))) return;
+#endif
 #if KILN_BOUNCE_STEP != 2
     vec3 gathered = gatherBlock(block);
 #endif
@@ -104,3 +146,4 @@ void main() {
 #endif
     }
 }
+#endif
