@@ -35,6 +35,13 @@
 //      The fireballs stay meshes by default: their rasterized triangles give a voxel
 //      several fragments where the splat gives one, and the reference prefers that
 //      weight (relMSE 0.0645 against 0.0655 at 256²).
+//   The tumblers on request (tumbler_mode splat): a compute pass (voxelize/tumblers.comp)
+//      adds one fragment to each voxel their exact round cone's surface passes through,
+//      lit at the surface point nearest the voxel's centre; rasterizing their low-poly
+//      meshes through the geometry shader cost 3.2 of voxelize's 7.1 ms at 720², the
+//      splat 1.4. Not the default: against the reference the floor next to the tumblers
+//      is worse (relMSE 0.0124 against the mesh's 0.0114 at 256², t = 0), though every
+//      region's mean light is closer (the floor's indirect light 0.966 -> 1.003×).
 //   4. A compute pass (4³ groups) resolves sum/count into `radiance`: rgb = the mean
 //      outgoing radiance, a = occupancy (1 where any fragment landed, else 0). The
 //      colour is premultiplied by the occupancy (empty voxels are 0,0,0,0), which is
@@ -46,6 +53,7 @@
 // (static geometry, bodies, particles, light) nor the shadow map changed.
 #include <kiln/pass.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <iterator>
 #include <string_view>
@@ -89,6 +97,12 @@ public:
                              "fireball, as one fragment, to the voxels its surface passes through (as accurate: "
                              "relMSE 0.0128 against 0.0130 at 256^2, t = 0; 50 fireballs cost the 720^2 frame "
                              "1.17x two where the mesh costs 1.32x)"))
+            .param(enumParam("tumbler_mode", "mesh", {"mesh", "splat"},
+                             "mesh: rasterize the low-poly mesh like every other mesh; splat: a compute pass adds "
+                             "one fragment to each voxel the exact shape's surface passes through "
+                             "(voxelize/tumblers.comp): voxelize 7.1 -> 5.3 ms at 720^2, but relMSE 0.0124 against "
+                             "0.0114 at 256^2, t = 0, and 0.0128 against 0.0125 at 128^2, t = 0.5 (the floor by "
+                             "the tumblers)"))
             .param(floatParam("lamp_emission", 0.0f, 0.0, 1.0,
                               "scale of the lamp dome's own emission in the voxels (its light already arrives "
                               "through composite's direct term: 1 counts it twice)"))
@@ -116,22 +130,27 @@ public:
         const bool splatParticles = particles && ctx.getEnum("particle_mode") == "splat";
         const bool splatFireballs = ctx.getEnum("fireball_mode") == "splat";
         GLuint splatter = splatParticles || splatFireballs ? ctx.program({.stages = {"voxelize/splat.comp"}, .defines = lamp}) : 0;
-        if (!raster || !resolve || ((splatParticles || splatFireballs) && !splatter)) return;
+        const bool splatTumblers = ctx.getEnum("tumbler_mode") == "splat";
+        GLuint tumblerSplatter = splatTumblers ? ctx.program({.stages = {"voxelize/tumblers.comp"}, .defines = lamp}) : 0;
+        if (!raster || !resolve || ((splatParticles || splatFireballs) && !splatter) || (splatTumblers && !tumblerSplatter))
+            return;
         if (field && !buildLampField(ctx)) return;
         const kiln::TextureRef& out = ctx.output("radiance");
         const int res = out.width;
 
         for (const Sum& sum : kSums) glClearTexImage(ctx.internal(sum.internal).id, 0, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
 
-        rasterize(ctx, raster, res, particles && !splatParticles, !splatFireballs);
+        rasterize(ctx, raster, res, particles && !splatParticles, !splatFireballs, !splatTumblers);
         if (splatter && !splat(ctx, splatter, res, splatParticles, splatFireballs)) return;
+        if (tumblerSplatter) splatTumblerShapes(ctx, tumblerSplatter, res);
         resolveSums(ctx, resolve, out, res);
     }
 
 private:
     // 1–3: the box, the tumblers and whatever is not splatted, rasterised into the sums
     // (no attachments: the fragment shader only does atomics); then the lamp.
-    void rasterize(kiln::PassContext& ctx, GLuint raster, int res, bool rasterParticles, bool rasterFireballs) {
+    void rasterize(kiln::PassContext& ctx, GLuint raster, int res, bool rasterParticles, bool rasterFireballs,
+                   bool rasterTumblers) {
         if (!fbo_) fbo_ = kiln::gl::createFramebuffer();
         if (fboSize_ != res) {
             glNamedFramebufferParameteri(fbo_.id(), GL_FRAMEBUFFER_DEFAULT_WIDTH, res);
@@ -150,7 +169,7 @@ private:
         kiln::gl::bindTexture(raster, "u_shadowMap", ctx.input("shadow_map").id);
         kiln::gl::bindTexture(raster, "u_lampField", ctx.internal("lamp_field").id);  // field only
         bindSums(ctx, raster, GL_READ_WRITE);
-        uint32_t cats = kiln::kSceneBox | kiln::kSceneTumblers;
+        uint32_t cats = kiln::kSceneBox | (rasterTumblers ? kiln::kSceneTumblers : 0u);
         if (rasterParticles) cats |= kiln::kSceneParticles;
         if (ctx.getBool("marbles")) cats |= kiln::kSceneMarbles;
         const GLint emissionScale = glGetUniformLocation(raster, "u_emissionScale");
@@ -194,6 +213,27 @@ private:
         glUniform1i(glGetUniformLocation(splatter, "u_sphereFlux"), ctx.getBool("fireball_flux") ? 1 : 0);
         glDispatchCompute((count + 63) / 64, 1, 1);
         return true;
+    }
+
+    // The tumblers from their exact shape (tumbler_mode splat): one invocation per voxel of
+    // the cube around each one's bounding ball (half its height plus its lower radius
+    // from the axis' midpoint), a row of groups per tumbler.
+    static void splatTumblerShapes(kiln::PassContext& ctx, GLuint program, int res) {
+        const kiln::SceneView& scene = ctx.scene();
+        const uint32_t tumblers = scene.count(kiln::kSceneTumblers);
+        if (tumblers == 0) return;
+        const glm::vec4& shape = scene.frame.tumblerShape;
+        const float reach = 0.5f * shape.w + shape.x, voxel = 2.0f / float(res);
+        const int side = std::min(res, int(std::ceil(2.0f * reach / voxel)) + 1);  // +1: the cube starts at a floor
+        glUseProgram(program);
+        kiln::gl::bindTexture(program, "u_shadowMap", ctx.input("shadow_map").id);
+        kiln::gl::bindTexture(program, "u_lampField", ctx.internal("lamp_field").id);  // field only
+        bindSums(ctx, program, GL_READ_WRITE);
+        glUniform1i(glGetUniformLocation(program, "u_res"), res);
+        glUniform1f(glGetUniformLocation(program, "u_shadowBias"), ctx.getFloat("shadow_bias"));
+        glUniform1ui(glGetUniformLocation(program, "u_first"), scene.firstInstance(kiln::kSceneTumblers));
+        glUniform1i(glGetUniformLocation(program, "u_side"), side);
+        glDispatchCompute(GLuint((side * side * side + 63) / 64), tumblers, 1);
     }
 
     // 4: the sums' averages into the outputs.

@@ -353,6 +353,81 @@ TEST_CASE("voxelize: splatted fireballs fill the voxels their surfaces pass thro
     }
 }
 
+TEST_CASE("voxelize: splatted tumblers fill the voxels their exact surface passes through, lit like their meshes",
+          "[gi][voxelize]") {
+    // The shipped scene 1 s in (tumblers rocking), voxelized with tumbler_mode mesh (the
+    // low-poly mesh rasterized) and splat (tumblers.comp from the round cone's distance),
+    // at 32³ and 64³. Against the simulation's own signed distance (sim::RoundCone::sdfWorld,
+    // in double precision): every voxel whose corners the surface separates is occupied
+    // by the splat, and the splat occupies no voxel whose centre lies more than half a
+    // voxel diagonal from every tumbler's surface that the mesh left empty. Against the
+    // mesh: the light and the occupied voxels of the whole volume, and the light within
+    // a voxel of the tumblers. Measured: 1 180 and 4 782 voxels crossed, none empty, none
+    // stray; Σ rgb 4 650 / 4 651 (32³) and 19 217 / 19 194 (64³); occupied 6 204 / 6 168 and
+    // 25 795 / 25 702; red + green by the tumblers 188.8 / 189.4 and 687.2 / 675.6. Bounds:
+    // 5 % and 3 % for the whole volume (a splat that dropped the tumblers loses ~1 200 / 4 800
+    // voxels' worth); 15 % by the tumblers, where the splat's one fragment a voxel meets
+    // the mesh's several and its exact surface the mesh's facets.
+    for (int res : {32, 64}) {
+        Volume vol[2];
+        std::vector<std::pair<sim::Vec3, sim::Quat>> poses;
+        sim::RoundCone shape;
+        for (int mode = 0; mode < 2; ++mode) {
+            Rig rig("", 64);
+            vol[mode] = voxelizedAtOneSecond(rig, R"(
+                {"id": "shadow", "module": "shadow", "params": {"size": 256}},
+                {"id": "voxelize", "module": "voxelize", "inputs": {"shadow_map": "shadow.depth"},
+                 "params": {"resolution": )" + std::to_string(res) + R"(, "tumbler_mode": ")" +
+                                                      (mode ? "splat" : "mesh") + R"("}})");
+            poses.clear();
+            for (auto& t : rig.app.scene().sim().tumblers()) poses.emplace_back(t.position, t.orientation);
+            shape = rig.app.scene().sim().shape();
+        }
+        REQUIRE(poses.size() == 5);
+        const double voxel = 2.0 / res;
+        auto distance = [&](const sim::Vec3& p) {
+            double d = 1e9;
+            for (auto& [position, orientation] : poses) d = std::min(d, shape.sdfWorld(p, position, orientation));
+            return d;
+        };
+        int crossed = 0, missing = 0, stray = 0;
+        double near[2] = {0, 0};
+        for (int z = 0; z < res; ++z)
+            for (int y = 0; y < res; ++y)
+                for (int x = 0; x < res; ++x) {
+                    const sim::Vec3 lo = sim::Vec3(x, y, z) * voxel - 1.0;
+                    bool inside = false, outside = false;
+                    for (int c = 0; c < 8; ++c) {
+                        const double d = distance(lo + voxel * sim::Vec3(c & 1, (c >> 1) & 1, c >> 2));
+                        inside = inside || d <= 0;
+                        outside = outside || d > 0;
+                    }
+                    const double centre = distance(lo + 0.5 * voxel);
+                    if (inside && outside) {
+                        ++crossed;
+                        missing += vol[1].at(x, y, z)[3] < 0.5f;
+                    }
+                    if (std::abs(centre) > 0.5 * std::sqrt(3.0) * voxel && vol[1].at(x, y, z)[3] > 0.5f &&
+                        vol[0].at(x, y, z)[3] < 0.5f)
+                        ++stray;
+                    if (std::abs(centre) < voxel)
+                        for (int mode = 0; mode < 2; ++mode) near[mode] += vol[mode].at(x, y, z)[0] + vol[mode].at(x, y, z)[1];
+                }
+        const VolumeTotals mesh = totals(vol[0]), splat = totals(vol[1]);
+        WARN(res << "³: " << crossed << " voxels the tumblers' surfaces cross, " << missing << " of them empty, " << stray
+                 << " stray; sum rgb mesh " << mesh.light << " splat " << splat.light << "; occupied mesh "
+                 << mesh.occupied << " splat " << splat.occupied << "; red + green by the tumblers mesh " << near[0]
+                 << " splat " << near[1]);
+        CHECK(crossed > (res == 32 ? 300 : 1200));
+        CHECK(missing == 0);
+        CHECK(stray == 0);
+        CHECK(splat.light == Approx(mesh.light).epsilon(0.05));
+        CHECK(splat.occupied == Approx(mesh.occupied).epsilon(0.03));
+        CHECK(near[1] > 0.85 * near[0]);
+        CHECK(near[1] < 1.15 * near[0]);
+    }
+}
+
 TEST_CASE("gbuffer: particles drawn as points cover what their meshes cover, where the simulation has them",
           "[gi][gbuffer]") {
     // The shipped scene 1 s in, the G-buffer at 256² with particle_mode points and mesh.
