@@ -85,7 +85,12 @@ MeshData makeParticle() {
     return m;
 }
 
-MeshData makeTumbler(float b, float t, float alpha, int slices, int stacks) {
+float areaPreservingInflation(float r, int n) {
+    const double ratio = n * std::sin(2.0 * M_PI / n) / (2.0 * M_PI);
+    return float(r * (1.0 / std::sqrt(ratio) - 1.0));
+}
+
+MeshData makeTumbler(float b, float t, float alpha, int slices, int stacks, float inflate) {
     // Profile rings from the bottom pole to the top pole: lower cap from −90° up to
     // latitude α (where the cone touches), the cone band, then the upper cap from α
     // to +90°. Cap normals are radial; the band's normal is the side normal.
@@ -100,6 +105,7 @@ MeshData makeTumbler(float b, float t, float alpha, int slices, int stacks) {
         float lat = alpha + (kPi / 2 - alpha) * static_cast<float>(i) / static_cast<float>(stacks);
         rings.push_back({yt + t * std::sin(lat), t * std::cos(lat), {std::cos(lat), std::sin(lat)}});
     }
+    for (auto& ring : rings) ring.y += inflate * ring.n.y, ring.r += inflate * ring.n.x;
     MeshData m;
     for (auto& ring : rings)
         for (int j = 0; j <= slices; ++j) {

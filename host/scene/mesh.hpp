@@ -34,7 +34,12 @@ MeshData makeUvSphere(int slices, int stacks);  // unit radius
 // Normals are radial: interpolated, they shade like a sphere.
 MeshData makeParticle();
 // A round cone: lower sphere radius b at the origin, upper sphere radius t at
-// (0, (b − t)/sin α, 0), joined by the tangent cone. `slices` around, `stacks` per cap.
-MeshData makeTumbler(float b, float t, float alpha, int slices, int stacks);
+// (0, (b − t)/sin α, 0), joined by the tangent cone. `slices` around, `stacks` per cap,
+// every vertex moved `inflate` along its normal (0: inscribed in the round cone).
+MeshData makeTumbler(float b, float t, float alpha, int slices, int stacks, float inflate = 0.0f);
+// How far to move an n-sided inscribed polygon's vertices out so that it has its
+// circle's area: r·(1/√(n·sin(2π/n)/(2π)) − 1) (the shadow of a coarse caster as large
+// as the round one's).
+float areaPreservingInflation(float r, int n);
 
 }  // namespace kiln::scene

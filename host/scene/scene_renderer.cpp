@@ -13,8 +13,10 @@ void SceneRenderer::buildMeshes(const SceneLook& look) {
     std::array<MeshData, kMeshCount> data = {
         makeQuad(),
         makeLampDome(look.lampCentre, look.lampRadius, 3, 1.0f),
-        makeTumbler(look.tumblerB, look.tumblerT, look.tumblerAlpha, 48, 16),
-        makeTumbler(look.tumblerB, look.tumblerT, look.tumblerAlpha, 12, 4),
+        makeTumbler(look.tumblerB, look.tumblerT, look.tumblerAlpha, 48, 16),  // the camera's,
+        makeTumbler(look.tumblerB, look.tumblerT, look.tumblerAlpha, 24, 8,  // Lod::Medium (the shadow map:
+                    areaPreservingInflation(look.tumblerB, 24)),             // a shadow as large as the round one),
+        makeTumbler(look.tumblerB, look.tumblerT, look.tumblerAlpha, 12, 4),   // Lod::Low (voxelization)
         makeUvSphere(kSphereSegments[0], 16),  // spheres by size on screen (sphereLevelFor): near,
         makeUvSphere(kSphereSegments[1], 8),   // mid,
         makeUvSphere(kSphereSegments[2], 6),   // far, and for voxelization
@@ -139,11 +141,10 @@ void SceneRenderer::sortSpheresBySize() {
 void SceneRenderer::rebuildGroups() {
     groups_.clear();
     uint32_t cursor = 0;
-    auto add = [&](MeshId mesh, MeshId lowMesh, SceneCategory cat) {
+    auto add = [&](MeshId mesh, SceneCategory cat) {  // one mesh at every level
         const uint32_t n = count(cat);
         if (n == 0) return;
-        groups_.push_back({mesh, cat, Lod::High, mesh == lowMesh, cursor, n});
-        if (mesh != lowMesh) groups_.push_back({lowMesh, cat, Lod::Low, false, cursor, n});
+        groups_.push_back({mesh, cat, Lod::High, true, cursor, n});
         cursor += n;
     };
     auto addSpheres = [&](SceneCategory cat, const std::array<uint32_t, 3>& levels) {
@@ -153,17 +154,25 @@ void SceneRenderer::rebuildGroups() {
             if (levels[size_t(i)] > 0) groups_.push_back({meshes[i], cat, Lod::High, false, at, levels[size_t(i)]});
             at += levels[size_t(i)];
         }
-        if (count(cat) > 0) groups_.push_back({kSphereLow, cat, Lod::Low, false, cursor, count(cat)});
+        if (count(cat) > 0) {
+            groups_.push_back({kSphereMid, cat, Lod::Medium, false, cursor, count(cat)});
+            groups_.push_back({kSphereLow, cat, Lod::Low, false, cursor, count(cat)});
+        }
         cursor += count(cat);
     };
     // The order of the instance buffer: static, bodies by category (spheres near to
     // far), particles.
-    add(kQuad, kQuad, kSceneBox);
-    add(kLamp, kLamp, kSceneLamp);
-    add(kTumblerHigh, kTumblerLow, kSceneTumblers);
+    add(kQuad, kSceneBox);
+    add(kLamp, kSceneLamp);
+    if (const uint32_t n = count(kSceneTumblers); n > 0) {
+        groups_.push_back({kTumblerHigh, kSceneTumblers, Lod::High, false, cursor, n});
+        groups_.push_back({kTumblerMid, kSceneTumblers, Lod::Medium, false, cursor, n});
+        groups_.push_back({kTumblerLow, kSceneTumblers, Lod::Low, false, cursor, n});
+        cursor += n;
+    }
     addSpheres(kSceneMarbles, sphereLevels_[0]);
     addSpheres(kSceneFireballs, sphereLevels_[1]);
-    add(kParticle, kParticle, kSceneParticles);
+    add(kParticle, kSceneParticles);
 }
 
 void SceneRenderer::upload() {

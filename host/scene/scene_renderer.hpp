@@ -77,7 +77,9 @@ public:
     uint64_t version(SceneCategory single) const { return versions_[sceneCategoryIndex(single)]; }
 
 private:
-    enum MeshId { kQuad, kLamp, kTumblerHigh, kTumblerLow, kSphereHigh, kSphereMid, kSphereLow, kParticle, kMeshCount };
+    enum MeshId {
+        kQuad, kLamp, kTumblerHigh, kTumblerMid, kTumblerLow, kSphereHigh, kSphereMid, kSphereLow, kParticle, kMeshCount
+    };
     struct MeshRange { uint32_t firstIndex = 0, indexCount = 0, baseVertex = 0; };
     struct Group { MeshId mesh; SceneCategory category; Lod lod; bool anyLod; uint32_t first, count; };
 

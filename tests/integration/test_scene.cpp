@@ -275,6 +275,64 @@ TEST_CASE("sphere level of detail: the silhouette stays within a pixel of the ci
     CHECK(scene::sphereLevelFor(500.0f) == 0);
 }
 
+TEST_CASE("shadow caster_mesh: the 24-slice casters cast the 48-slice ones' shadow, the 12-slice ones a smaller one",
+          "[scene][gl]") {
+    // Five tumblers, upright and tilted, nothing else (a marble's mesh in the camera's
+    // list depends on its size on screen), into the default's 512² map with each caster
+    // mesh. What decides a shadow is where a caster is (depth < 1): the covered texels.
+    // auto = medium at 512²: its tumblers are 24-gons moved out to their circle's area
+    // (an inscribed 48-gon has 0.3 % less, an inscribed 12-gon 4.5 %). Measured: covered texels medium / fine
+    // 1.003 (the 48-gon's own shortfall), coarse / fine 0.962; texels covered by one and
+    // not the other 0.5 % of the fine map's, 3.8 % for coarse. Bounds: 1 % in area, 2 %
+    // differing texels — a 12-slice caster fails both, as it lightened the floor by 0.5 %
+    // at 128², t = 0.5.
+    const fs::path scene = fs::path(TEST_OUTPUT_DIR) / "five_tumblers.json";
+    std::ofstream(scene) << R"({"tumblers": [
+        {"position": [-0.5, -0.4], "tilt": [0.0, 0.0]}, {"position": [0.5, -0.4], "tilt": [0.3, 0.0]},
+        {"position": [0.0, 0.0], "tilt": [0.0, -0.5]}, {"position": [-0.5, 0.5], "tilt": [0.2, 0.2]},
+        {"position": [0.5, 0.5], "tilt": [-0.4, 0.1]}]})";
+    Rig rig(scene.string());
+    std::string errors;
+    auto map = [&](const std::string& mesh) {
+        rig.app.runtime().setRequested({"shadow.depth"});  // not an input of the output's producer: kept all the same
+        const bool loaded = rig.app.runtime().loadPipelineText(R"({"output": "gbuffer.albedo", "passes": [
+            {"id": "gbuffer", "module": "gbuffer"},
+            {"id": "shadow", "module": "shadow", "params": {"size": 512, "caster_mesh": ")" + mesh + R"("}}]})",
+                                                               "shadow.json", errors);
+        INFO(errors);
+        REQUIRE(loaded);
+        rig.app.frame();
+        const TextureRef* depth = rig.app.runtime().findTexture("shadow", "depth");
+        REQUIRE(depth);
+        REQUIRE(depth->width == 512);
+        return readTexture(depth->id, depth->target, depth->format, depth->width, depth->height);
+    };
+    const FloatImage fine = map("fine"), medium = map("auto"), coarse = map("coarse");
+    auto compare = [&](const FloatImage& other, double& areaRatio, double& differing) {
+        double covered = 0, otherCovered = 0, mismatched = 0;
+        for (int y = 0; y < fine.height; ++y)
+            for (int x = 0; x < fine.width; ++x) {
+                const float a = fine.at(x, y)[0], b = other.at(x, y)[0];
+                covered += a < 1.0f;
+                otherCovered += b < 1.0f;
+                mismatched += (a < 1.0f) != (b < 1.0f);
+            }
+        REQUIRE(covered > 2000);
+        areaRatio = otherCovered / covered;
+        differing = mismatched / covered;
+    };
+    double mediumArea, mediumDiffering, coarseArea, coarseDiffering;
+    compare(medium, mediumArea, mediumDiffering);
+    compare(coarse, coarseArea, coarseDiffering);
+    WARN("covered texels against the 48-slice casters: medium " << mediumArea << " (" << mediumDiffering
+                                                              << " differing), coarse " << coarseArea << " ("
+                                                              << coarseDiffering << ")");
+    CHECK(std::abs(mediumArea - 1.0) < 0.01);
+    CHECK(mediumDiffering < 0.02);
+    CHECK(std::abs(coarseArea - 1.0) > 0.01);
+    CHECK(coarseDiffering > 0.02);
+}
+
 TEST_CASE("composite shadow_filter pcss: the tumbler's shadow keeps its core and gets a wider edge than one lookup",
           "[scene][gl]") {
     Rig rig(oneTumblerScene());
