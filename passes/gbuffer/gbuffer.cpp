@@ -57,7 +57,16 @@ public:
         kiln::DrawFilter filter;
         filter.categories = kiln::kSceneGeometry;
         if (!particles || points) filter.categories &= ~kiln::kSceneParticles;
+        // The bodies are closed, so their back faces never show: culled, they cost
+        // llvmpipe no setup (13.3 against 16.4 ms at 720²), and no back face wins a
+        // depth tie at a silhouette (3 pixels of 360² did). The walls and the lamp's dome
+        // are open surfaces, seen from either side.
+        filter.categories &= ~kiln::kSceneBodies;
         ctx.drawScene(filter);
+        glEnable(GL_CULL_FACE);
+        glCullFace(GL_BACK);
+        ctx.drawScene({.categories = kiln::kSceneBodies});
+        glDisable(GL_CULL_FACE);
 
         // Thousands of particles a few pixels wide: one point each, not 8 triangles
         // (4 000 octahedra cost the G-buffer 15 ms at 720² on llvmpipe).
