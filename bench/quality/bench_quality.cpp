@@ -89,6 +89,7 @@ const char* const kDefaultSweeps[] = {
     "cone_trace.output_divisor=1,2",  "composite.lamp_samples=8,16,32",
     "voxel_mip.feedback=false,true",  "voxel_mip.gather_diameter_offset=1,1.25,1.5",
     "composite.lamp_model=field,contour,points",
+    "shadow.caster_mesh=fine,medium,coarse", "voxelize.tumbler_mode=mesh,splat",
 };
 
 struct Args {
