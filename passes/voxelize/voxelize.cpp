@@ -162,13 +162,8 @@ private:
         glDisable(GL_DEPTH_TEST);
         glDisable(GL_CULL_FACE);
         glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
-        glUseProgram(raster);
-        glUniform1i(glGetUniformLocation(raster, "u_res"), res);
+        useSurfaceProgram(ctx, raster, res);
         glUniform1f(glGetUniformLocation(raster, "u_conservative"), ctx.getBool("conservative") ? 1.0f : 0.0f);
-        glUniform1f(glGetUniformLocation(raster, "u_shadowBias"), ctx.getFloat("shadow_bias"));
-        kiln::gl::bindTexture(raster, "u_shadowMap", ctx.input("shadow_map").id);
-        kiln::gl::bindTexture(raster, "u_lampField", ctx.internal("lamp_field").id);  // field only
-        bindSums(ctx, raster, GL_READ_WRITE);
         uint32_t cats = kiln::kSceneBox | (rasterTumblers ? kiln::kSceneTumblers : 0u);
         if (rasterParticles) cats |= kiln::kSceneParticles;
         if (ctx.getBool("marbles")) cats |= kiln::kSceneMarbles;
@@ -186,6 +181,17 @@ private:
         glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     }
 
+    // A program that lights surfaces (voxelize/surface.glsl) and adds them to the sums:
+    // in use, with its shadow map, lamp field, sums and their uniforms bound.
+    static void useSurfaceProgram(kiln::PassContext& ctx, GLuint program, int res) {
+        glUseProgram(program);
+        kiln::gl::bindTexture(program, "u_shadowMap", ctx.input("shadow_map").id);
+        kiln::gl::bindTexture(program, "u_lampField", ctx.internal("lamp_field").id);  // field only
+        bindSums(ctx, program, GL_READ_WRITE);
+        glUniform1i(glGetUniformLocation(program, "u_res"), res);
+        glUniform1f(glGetUniformLocation(program, "u_shadowBias"), ctx.getFloat("shadow_bias"));
+    }
+
     // The fireballs and particles, splatted. They are neighbours in the instance buffer,
     // fireballs first, so one dispatch covers both: its first u_litCount spheres are lit.
     // (Two dispatches in a row, with other uniforms, lost most of both on llvmpipe.)
@@ -200,12 +206,7 @@ private:
         const uint32_t first = scene.firstInstance(splatFireballs ? kiln::kSceneFireballs : kiln::kSceneParticles);
         const uint32_t count = splatFireballs ? fireballs + sparks : sparks;
         if (count == 0) return true;
-        glUseProgram(splatter);
-        kiln::gl::bindTexture(splatter, "u_shadowMap", ctx.input("shadow_map").id);
-        kiln::gl::bindTexture(splatter, "u_lampField", ctx.internal("lamp_field").id);  // field only
-        bindSums(ctx, splatter, GL_READ_WRITE);
-        glUniform1i(glGetUniformLocation(splatter, "u_res"), res);
-        glUniform1f(glGetUniformLocation(splatter, "u_shadowBias"), ctx.getFloat("shadow_bias"));
+        useSurfaceProgram(ctx, splatter, res);
         glUniform1ui(glGetUniformLocation(splatter, "u_first"), first);
         glUniform1ui(glGetUniformLocation(splatter, "u_sphereCount"), count);
         glUniform1ui(glGetUniformLocation(splatter, "u_litCount"), fireballs);
@@ -225,12 +226,7 @@ private:
         const glm::vec4& shape = scene.frame.tumblerShape;
         const float reach = 0.5f * shape.w + shape.x, voxel = 2.0f / float(res);
         const int side = std::min(res, int(std::ceil(2.0f * reach / voxel)) + 1);  // +1: the cube starts at a floor
-        glUseProgram(program);
-        kiln::gl::bindTexture(program, "u_shadowMap", ctx.input("shadow_map").id);
-        kiln::gl::bindTexture(program, "u_lampField", ctx.internal("lamp_field").id);  // field only
-        bindSums(ctx, program, GL_READ_WRITE);
-        glUniform1i(glGetUniformLocation(program, "u_res"), res);
-        glUniform1f(glGetUniformLocation(program, "u_shadowBias"), ctx.getFloat("shadow_bias"));
+        useSurfaceProgram(ctx, program, res);
         glUniform1ui(glGetUniformLocation(program, "u_first"), scene.firstInstance(kiln::kSceneTumblers));
         glUniform1i(glGetUniformLocation(program, "u_side"), side);
         glDispatchCompute(GLuint((side * side * side + 63) / 64), tumblers, 1);

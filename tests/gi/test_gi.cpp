@@ -81,6 +81,14 @@ Volume voxelizedAtOneSecond(Rig& rig, const std::string& passes) {
     return read3d(rig.tex("voxelize", "radiance"), 0);
 }
 
+// The same with a 256² shadow map and voxelize at res³ with one enum parameter set.
+Volume voxelizedAtOneSecond(Rig& rig, int res, const std::string& param, const std::string& value) {
+    return voxelizedAtOneSecond(rig, R"(
+        {"id": "shadow", "module": "shadow", "params": {"size": 256}},
+        {"id": "voxelize", "module": "voxelize", "inputs": {"shadow_map": "shadow.depth"},
+         "params": {"resolution": )" + std::to_string(res) + R"(, ")" + param + R"(": ")" + value + R"("}})");
+}
+
 // A gi_volume `pattern` at res³ through voxel_mip in `mode`, shown by a voxel_view, one
 // frame; `keep` are the textures read back.
 void mipVolume(Rig& rig, const std::string& pattern, int res, const std::string& mode, std::vector<std::string> keep) {
@@ -301,11 +309,7 @@ TEST_CASE("voxelize: splatted fireballs fill the voxels their surfaces pass thro
         std::vector<std::pair<glm::vec3, float>> fireballs;
         for (int mode = 0; mode < 2; ++mode) {
             Rig rig("", 64);
-            vol[mode] = voxelizedAtOneSecond(rig, R"(
-                {"id": "shadow", "module": "shadow", "params": {"size": 256}},
-                {"id": "voxelize", "module": "voxelize", "inputs": {"shadow_map": "shadow.depth"},
-                 "params": {"resolution": )" + std::to_string(res) + R"(, "fireball_mode": ")" +
-                                                      (mode ? "splat" : "mesh") + R"("}})");
+            vol[mode] = voxelizedAtOneSecond(rig, res, "fireball_mode", mode ? "splat" : "mesh");
             fireballs.clear();
             for (auto& b : rig.app.scene().sim().balls())
                 if (b.kind == sim::BallKind::Fireball)
@@ -374,11 +378,7 @@ TEST_CASE("voxelize: splatted tumblers fill the voxels their exact surface passe
         sim::RoundCone shape;
         for (int mode = 0; mode < 2; ++mode) {
             Rig rig("", 64);
-            vol[mode] = voxelizedAtOneSecond(rig, R"(
-                {"id": "shadow", "module": "shadow", "params": {"size": 256}},
-                {"id": "voxelize", "module": "voxelize", "inputs": {"shadow_map": "shadow.depth"},
-                 "params": {"resolution": )" + std::to_string(res) + R"(, "tumbler_mode": ")" +
-                                                      (mode ? "splat" : "mesh") + R"("}})");
+            vol[mode] = voxelizedAtOneSecond(rig, res, "tumbler_mode", mode ? "splat" : "mesh");
             poses.clear();
             for (auto& t : rig.app.scene().sim().tumblers()) poses.emplace_back(t.position, t.orientation);
             shape = rig.app.scene().sim().shape();
