@@ -51,7 +51,8 @@
 //              (black / white / flat normal / far depth). An unbound optional input
 //              reaches your shaders as `#define KILN_HAS_<SLOT> 0` (1 when bound).
 //   outputs    format, 2D/3D, size rule, mip count. Size rules: relative to the output
-//              size, the output size divided by an int parameter (relativeOverParam),
+//              size, the output size divided by an int parameter (relativeOverParam;
+//              a second int parameter may cap the texels across, kiln::sizeDivisor),
 //              fixed, a side taken from an int parameter (fromParam), or the size of
 //              what is bound to one of your inputs (fromInput). An output that only some
 //              values of an enum parameter fill says so (producedWhen): binding it
@@ -148,9 +149,10 @@ namespace kiln {
 
 // Bump when anything in this header (or what it includes) changes layout or vtables,
 // or when what the host does for a pass changes (6: the host issues the barrier
-// between passes; 7: GpuFrame::boxWalls; 8: PassContext::keepRunning), so a module
-// built for other terms is refused by name, not run.
-inline constexpr uint32_t kPassAbiVersion = 8;
+// between passes; 7: GpuFrame::boxWalls; 8: PassContext::keepRunning; 9:
+// SizeRule::capSource and Lod::Medium), so a module built for other terms is refused
+// by name, not run.
+inline constexpr uint32_t kPassAbiVersion = 9;
 
 struct TextureRef {
     GLuint id = 0;
