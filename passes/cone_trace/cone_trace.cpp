@@ -136,6 +136,8 @@ public:
     kiln::PassDeclaration declare() const override {
         using namespace kiln;
         PassDeclaration d;
+        // The strided trace's textures: the output's size over the stride, capped at trace_samples across.
+        const auto traceGrid = SizeRule::relativeOverParam("trace_stride", 1.0f, "trace_samples");
         d.input({.name = "normal", .doc = "gbuffer.normal"})
             .input({.name = "depth", .kind = TextureKind::Depth2D, .doc = "gbuffer.depth"})
             .input({.name = "voxels", .kind = TextureKind::Color3D, .doc = "voxel_mip.iso (level 0 = voxelize.radiance)"})
@@ -146,19 +148,19 @@ public:
             .output({.name = "indirect", .format = Format::RGBA16F, .size = SizeRule::relativeOverParam("output_divisor"),
                      .doc = "rgb = indirect irradiance / π, a = AO (or with `lamp`: the lamp's projected solid "
                             "angle); the output's size ÷ output_divisor"})
-            .internal({.name = "samples", .format = Format::RGBA16F, .size = SizeRule::relativeOverParam("trace_stride", 1.0f, "trace_samples"),
+            .internal({.name = "samples", .format = Format::RGBA16F, .size = traceGrid,
                        .doc = "trace_stride > 1: the traced samples"})
-            .internal({.name = "planes", .format = Format::RGBA16F, .size = SizeRule::relativeOverParam("trace_stride", 1.0f, "trace_samples"),
+            .internal({.name = "planes", .format = Format::RGBA16F, .size = traceGrid,
                        .doc = "trace_stride > 1: each sample's surface, xyz = normal, w = n·p (0,0,0 off geometry)"})
-            .internal({.name = "ages", .format = Format::RGBA32F, .size = SizeRule::relativeOverParam("trace_stride", 1.0f, "trace_samples"),
+            .internal({.name = "ages", .format = Format::RGBA32F, .size = traceGrid,
                        .doc = "reuse_frames > 1: x = frames each sample's light has been kept (0: traced this frame), "
                               "yzw = the world point it was traced at"})
-            .internal({.name = "history", .format = Format::RGBA16F, .size = SizeRule::relativeOverParam("trace_stride", 1.0f, "trace_samples"),
+            .internal({.name = "history", .format = Format::RGBA16F, .size = traceGrid,
                        .doc = "reuse_frames > 1: last frame's samples"})
             .internal({.name = "history_planes", .format = Format::RGBA16F,
-                       .size = SizeRule::relativeOverParam("trace_stride", 1.0f, "trace_samples"), .doc = "reuse_frames > 1: their surfaces"})
+                       .size = traceGrid, .doc = "reuse_frames > 1: their surfaces"})
             .internal({.name = "history_ages", .format = Format::RGBA32F,
-                       .size = SizeRule::relativeOverParam("trace_stride", 1.0f, "trace_samples"), .doc = "reuse_frames > 1: their ages and points"})
+                       .size = traceGrid, .doc = "reuse_frames > 1: their ages and points"})
             .param(intChoiceParam("cones", 6, {1, 5, 6, 9, 16},
                                   "diffuse cones per pixel, around the normal (with fixed_cones bound: 6, the fixed set)"))
             .param(floatParam("aperture", 60.0f, 5.0, 150.0, "cone opening angle, degrees"))

@@ -214,12 +214,9 @@ public:
             glCopyImageSubData(bounced.id, GL_TEXTURE_3D, 0, 0, 0, 0, chain.id, GL_TEXTURE_3D, 0, 0, 0, 0, res, res, res);
             buildChains(ctx, iso, aniso, blend);
         }
-        if (listed) {
-            listSurfaceBlocks(ctx, list, kept.id);
-            dispatchGather(ctx, keep, kept.id, chain.id, true);
-            ctx.keepRunning(kFeedbackSettleFrames, "voxel bounces fed back");
-        } else if (feedback) {
-            dispatchGather(ctx, keep, kept.id, chain.id);
+        if (feedback) {
+            if (listed) listSurfaceBlocks(ctx, list, kept.id);
+            dispatchGather(ctx, keep, kept.id, chain.id, listed);
             ctx.keepRunning(kFeedbackSettleFrames, "voxel bounces fed back");
         }
     }

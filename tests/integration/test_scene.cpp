@@ -281,9 +281,9 @@ TEST_CASE("shadow caster_mesh: the 24-slice casters cast the 48-slice ones' shad
     // list depends on its size on screen), into the default's 512² map with each caster
     // mesh. What decides a shadow is where a caster is (depth < 1): the covered texels.
     // auto = medium at 512²: its tumblers are 24-gons moved out to their circle's area
-    // (an inscribed 48-gon has 0.3 % less, an inscribed 12-gon 4.5 %). Measured: covered texels medium / fine
-    // 1.003 (the 48-gon's own shortfall), coarse / fine 0.962; texels covered by one and
-    // not the other 0.5 % of the fine map's, 3.8 % for coarse. Bounds: 1 % in area, 2 %
+    // (an inscribed 48-gon has 0.3 % less, an inscribed 12-gon 4.5 %). Measured: covered
+    // texels medium / fine 1.003 (the 48-gon's own shortfall), coarse / fine 0.962;
+    // texels covered by one and not the other 0.5 % of the fine map's, 3.8 % for coarse. Bounds: 1 % in area, 2 %
     // differing texels — a 12-slice caster fails both, as it lightened the floor by 0.5 %
     // at 128², t = 0.5.
     const fs::path scene = fs::path(TEST_OUTPUT_DIR) / "five_tumblers.json";
@@ -292,9 +292,9 @@ TEST_CASE("shadow caster_mesh: the 24-slice casters cast the 48-slice ones' shad
         {"position": [0.0, 0.0], "tilt": [0.0, -0.5]}, {"position": [-0.5, 0.5], "tilt": [0.2, 0.2]},
         {"position": [0.5, 0.5], "tilt": [-0.4, 0.1]}]})";
     Rig rig(scene.string());
+    rig.app.runtime().setRequested({"shadow.depth"});  // not an input of the output's producer: kept all the same
     std::string errors;
     auto map = [&](const std::string& mesh) {
-        rig.app.runtime().setRequested({"shadow.depth"});  // not an input of the output's producer: kept all the same
         const bool loaded = rig.app.runtime().loadPipelineText(R"({"output": "gbuffer.albedo", "passes": [
             {"id": "gbuffer", "module": "gbuffer"},
             {"id": "shadow", "module": "shadow", "params": {"size": 512, "caster_mesh": ")" + mesh + R"("}}]})",
