@@ -290,11 +290,145 @@ std::string infoLog(GLuint object, bool isProgram) {
     s.resize(std::strlen(s.c_str()));
     return s;
 }
+// OpenGL 4.5 core's guaranteed minimums (the specification's table of implementation
+// limits) for what a shader names by binding: GL_MAX_IMAGE_UNITS and
+// GL_MAX_COMBINED_IMAGE_UNIFORMS, GL_MAX_{FRAGMENT,COMPUTE}_IMAGE_UNIFORMS,
+// GL_MAX_SHADER_STORAGE_BUFFER_BINDINGS and GL_MAX_{FRAGMENT,COMPUTE}_SHADER_STORAGE_BLOCKS.
+constexpr GLint kGuaranteedImageUnits = 8, kGuaranteedStorageBindings = 8;
+
+bool isImageType(GLint type) { return type >= GL_IMAGE_1D && type <= GL_UNSIGNED_INT_IMAGE_2D_MULTISAMPLE_ARRAY; }
+
+// The query that asks whether a stage references a resource, per stage.
+struct StageRef {
+    GLenum referencedBy, stage;
+};
+constexpr StageRef kStageRefs[] = {{GL_REFERENCED_BY_VERTEX_SHADER, GL_VERTEX_SHADER},
+                                   {GL_REFERENCED_BY_TESS_CONTROL_SHADER, GL_TESS_CONTROL_SHADER},
+                                   {GL_REFERENCED_BY_TESS_EVALUATION_SHADER, GL_TESS_EVALUATION_SHADER},
+                                   {GL_REFERENCED_BY_GEOMETRY_SHADER, GL_GEOMETRY_SHADER},
+                                   {GL_REFERENCED_BY_FRAGMENT_SHADER, GL_FRAGMENT_SHADER},
+                                   {GL_REFERENCED_BY_COMPUTE_SHADER, GL_COMPUTE_SHADER}};
+
+// Each image uniform (every array element) or storage block of a linked program: its
+// binding and the stages that use it.
+struct BoundResource {
+    std::string name;
+    GLint binding = 0;
+    std::vector<GLenum> stages;
+};
+
+std::vector<BoundResource> boundResources(GLuint program, GLenum interface) {
+    std::vector<BoundResource> out;
+    GLint count = 0, nameLength = 0;
+    glGetProgramInterfaceiv(program, interface, GL_ACTIVE_RESOURCES, &count);
+    glGetProgramInterfaceiv(program, interface, GL_MAX_NAME_LENGTH, &nameLength);
+    for (GLint i = 0; i < count; ++i) {
+        std::string name(size_t(std::max(nameLength, 1)), '\0');
+        glGetProgramResourceName(program, interface, GLuint(i), nameLength, nullptr, name.data());
+        name.resize(std::strlen(name.c_str()));
+        std::vector<GLenum> stages;
+        for (const StageRef& ref : kStageRefs) {
+            GLint used = 0;
+            glGetProgramResourceiv(program, interface, GLuint(i), 1, &ref.referencedBy, 1, nullptr, &used);
+            if (used) stages.push_back(ref.stage);
+        }
+        if (interface == GL_SHADER_STORAGE_BLOCK) {
+            const GLenum prop = GL_BUFFER_BINDING;
+            GLint binding = 0;
+            glGetProgramResourceiv(program, interface, GLuint(i), 1, &prop, 1, nullptr, &binding);
+            out.push_back({name, binding, stages});
+            continue;
+        }
+        const GLenum props[] = {GL_TYPE, GL_LOCATION, GL_ARRAY_SIZE};
+        GLint values[3] = {};
+        glGetProgramResourceiv(program, interface, GLuint(i), 3, props, 3, nullptr, values);
+        if (!isImageType(values[0]) || values[1] < 0) continue;
+        const bool array = name.ends_with("[0]");
+        if (array) name.resize(name.size() - 3);
+        for (GLint element = 0; element < std::max(values[2], 1); ++element) {
+            GLint unit = 0;
+            glGetUniformiv(program, values[1] + element, &unit);
+            out.push_back({array ? str(name, "[", element, "]") : name, unit, stages});
+        }
+    }
+    return out;
+}
+
+// Where a resource is declared: the first line of a stage's source that uses it with
+// a binding qualifier ("... binding = N ... u_name" or a block "buffer Name"), as that
+// stage's file and line; else the stage's own file.
+struct CompiledStage {
+    GLenum stage;
+    PreprocessedSource source;
+};
+
+ShaderError declaredAt(const std::vector<CompiledStage>& stages, const std::vector<GLenum>& usedBy,
+                       const std::string& resource) {
+    const std::string name = resource.substr(0, resource.find('['));
+    auto isIdentifier = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; };
+    for (const CompiledStage& stage : stages) {
+        // (Mesa reports no referencing stage for storage blocks: then any stage.)
+        if (!usedBy.empty() && std::find(usedBy.begin(), usedBy.end(), stage.stage) == usedBy.end()) continue;
+        const PreprocessedSource& src = stage.source;
+        std::istringstream text(src.text);
+        std::string line;
+        for (size_t at = 0; std::getline(text, line); ++at) {
+            if (line.find("binding") == std::string::npos) continue;
+            for (size_t pos = line.find(name); pos != std::string::npos; pos = line.find(name, pos + 1)) {
+                const size_t end = pos + name.size();
+                if ((pos > 0 && isIdentifier(line[pos - 1])) || (end < line.size() && isIdentifier(line[end])))
+                    continue;
+                if (at < src.lines.size())
+                    return {src.files[size_t(src.lines[at].file)], src.lines[at].line, ""};
+            }
+        }
+        return {src.files.empty() ? "" : src.files[0], 0, ""};
+    }
+    return {stages.empty() || stages[0].source.files.empty() ? "" : stages[0].source.files[0], 0, ""};
+}
+
+// What the linked program uses beyond kGuaranteed*, each where it is declared.
+std::vector<ShaderError> portabilityIssues(const std::vector<CompiledStage>& stages, GLuint program) {
+    std::vector<ShaderError> issues;
+    struct Kind {
+        GLenum interface;
+        const char *what, *units, *consequence;
+        GLint guaranteed;
+    };
+    for (const Kind& kind :
+         {Kind{GL_UNIFORM, "image", "image unit", "NVIDIA's image units stop there: it will not link on its driver",
+               kGuaranteedImageUnits},
+          Kind{GL_SHADER_STORAGE_BLOCK, "storage block", "storage buffer binding",
+               "a driver at the minimum will not link it", kGuaranteedStorageBindings}}) {
+        const std::vector<BoundResource> resources = boundResources(program, kind.interface);
+        for (const BoundResource& r : resources)
+            if (r.binding >= kind.guaranteed) {
+                ShaderError issue = declaredAt(stages, r.stages, r.name);
+                issue.message = str(kind.what, " '", r.name, "' is bound to ", kind.units, " ", r.binding,
+                                    "; OpenGL 4.5 guarantees 0-", kind.guaranteed - 1, " only (", kind.consequence, ")");
+                issues.push_back(std::move(issue));
+            }
+        for (const CompiledStage& stage : stages) {
+            if (stage.stage != GL_FRAGMENT_SHADER && stage.stage != GL_COMPUTE_SHADER) continue;
+            const auto used = std::count_if(resources.begin(), resources.end(), [&](const BoundResource& r) {
+                return std::find(r.stages.begin(), r.stages.end(), stage.stage) != r.stages.end();
+            });
+            if (used > kind.guaranteed)
+                issues.push_back({stage.source.files.empty() ? "" : stage.source.files[0], 0,
+                                  str("uses ", used, " ", kind.what, "s; OpenGL 4.5 guarantees a ",
+                                      stage.stage == GL_COMPUTE_SHADER ? "compute" : "fragment", " shader ",
+                                      kind.guaranteed, " only")});
+        }
+    }
+    return issues;
+}
+
 }  // namespace
 
 ProgramBuild buildProgram(const ShaderLibrary& lib, const ProgramDesc& desc) {
     ProgramBuild build;
     std::vector<gl::ShaderHandle> shaders;
+    std::vector<CompiledStage> compiled;
     for (auto& stagePath : desc.stages) {
         GLenum stage = stageOf(stagePath);
         if (!stage) {
@@ -321,6 +455,7 @@ ProgramBuild buildProgram(const ShaderLibrary& lib, const ProgramDesc& desc) {
             continue;
         }
         shaders.push_back(std::move(sh));
+        compiled.push_back({stage, std::move(src)});
     }
     if (!build.errors.empty()) return build;
 
@@ -337,6 +472,7 @@ ProgramBuild buildProgram(const ShaderLibrary& lib, const ProgramDesc& desc) {
         return build;
     }
     gl::label(GL_PROGRAM, program.id(), desc.debugName.empty() ? desc.stages.front() : desc.debugName);
+    build.portability = portabilityIssues(compiled, program.id());
     build.program = std::move(program);
     return build;
 }

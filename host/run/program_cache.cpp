@@ -15,6 +15,16 @@ std::string keyOf(const ProgramDesc& desc) {
     return key;
 }
 
+// Logged once per build (a rebuild after an edit says it again, or stops saying it).
+std::vector<std::string> portabilityOf(const ProgramBuild& build) {
+    std::vector<std::string> out;
+    for (const ShaderError& issue : build.portability) {
+        out.push_back(issue.toString());
+        log::warn(out.back());
+    }
+    return out;
+}
+
 std::string errorOf(const ProgramBuild& build) {
     std::string e = build.errorText();
     if (!e.empty() && e.back() == '\n') e.pop_back();
@@ -34,6 +44,7 @@ GLuint ProgramCache::get(const ShaderLibrary& shaders, const ProgramDesc& desc, 
         entry.dependencies = build.dependencies;
         ++generation_;
         if (build.ok()) {
+            entry.portability = portabilityOf(build);
             entry.program = std::move(build.program);
         } else {
             entry.error = errorOf(build);
@@ -66,6 +77,7 @@ int ProgramCache::reload(const ShaderLibrary& shaders, const std::vector<std::fi
         ProgramBuild build = buildProgram(shaders, entry.desc);
         if (!build.dependencies.empty()) entry.dependencies = build.dependencies;
         if (build.ok()) {
+            entry.portability = portabilityOf(build);
             entry.program = std::move(build.program);
             entry.error.clear();
             ++generation_;
@@ -83,6 +95,13 @@ std::vector<std::string> ProgramCache::standingErrors() const {
     for (auto& [key, entry] : entries_)
         if (!entry.error.empty() && entry.program) errors.push_back(entry.error);
     return errors;
+}
+
+std::vector<std::string> ProgramCache::portabilityWarnings() const {
+    std::vector<std::string> warnings;
+    for (auto& [key, entry] : entries_)
+        if (entry.program) warnings.insert(warnings.end(), entry.portability.begin(), entry.portability.end());
+    return warnings;
 }
 
 }  // namespace kiln::run

@@ -31,6 +31,9 @@ public:
     uint64_t generation() const { return generation_; }
     // Errors of edits that broke a program whose last good version still runs.
     std::vector<std::string> standingErrors() const;
+    // Of the programs in use: what each uses beyond OpenGL 4.5's guaranteed minimums
+    // (ProgramBuild::portability), one line each.
+    std::vector<std::string> portabilityWarnings() const;
     size_t size() const { return entries_.size(); }
 
 private:
@@ -38,6 +41,7 @@ private:
         ProgramDesc desc;           // as built (defines included), to rebuild on a shader edit
         gl::ProgramHandle program;  // the last good one
         std::string error;
+        std::vector<std::string> portability;  // of `program`
         std::vector<std::filesystem::path> dependencies;
         uint64_t lastUse = 0;
     };

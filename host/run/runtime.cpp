@@ -512,6 +512,13 @@ std::vector<std::string> Runtime::activeErrors() const {
     return errors;
 }
 
+std::vector<std::string> Runtime::portabilityWarnings() const {
+    std::vector<std::string> warnings;
+    for (auto& s : slots_)
+        for (auto& w : s->programs.portabilityWarnings()) warnings.push_back(s->id + ": " + w);
+    return warnings;
+}
+
 void Runtime::setExternalError(const std::string& key, const std::string& message) {
     if (message.empty()) externalErrors_.erase(key);
     else externalErrors_[key] = message;

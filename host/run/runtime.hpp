@@ -113,6 +113,10 @@ public:
     const ShaderLibrary& shaders() const { return *shaders_; }
     // Errors currently standing (shader compile, pass failures), for the overlay.
     std::vector<std::string> activeErrors() const;
+    // The running passes' programs' uses of more than OpenGL 4.5 guarantees
+    // ("pass: file: what"), logged when each was built: they run here but would not
+    // link on a driver at the minimum.
+    std::vector<std::string> portabilityWarnings() const;
 
 private:
     void adoptPlan(graph::Plan plan);

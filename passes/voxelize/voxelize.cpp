@@ -20,7 +20,7 @@
 //      tilted surface leaves no 6-connected gap (light can't leak through it) and an
 //      axis-aligned wall is exactly one voxel thick.
 //   3. Combining fragments that land in one voxel: an exact AVERAGE, order-free. Four
-//      R32UI volumes (internals sum_r, sum_g, sum_b, count) receive imageAtomicAdd of
+//      R32UI grids (channels of the internal `sums`) receive imageAtomicAdd of
 //      the fragment's radiance in 1/512 fixed point (clamped to 2048 per channel, so
 //      over 4000 fragments fit a voxel before overflow) and of 1. No compare-and-swap
 //      loop (the RGBA8 running-average trick serialises colliding fragments and
@@ -74,8 +74,10 @@ public:
                      .doc = "rgb = the surfaces' mean albedo (particles count as 0), a = occupancy"})
             .output({.name = "normal", .kind = TextureKind::Color3D, .format = Format::RGBA16F, .size = cube,
                      .doc = "xyz = the surfaces' mean unit normal (shorter where they disagree), a = occupancy"});
-        for (const Sum& sum : kSums)
-            d.internal({.name = sum.internal, .kind = TextureKind::Color3D, .format = Format::R32UI, .size = cube});
+        d.internal({.name = "sums", .kind = TextureKind::Color3D, .format = Format::R32UI,
+                    .size = SizeRule::fromParam("resolution", 1.0f, kSumChannels),
+                    .doc = "the fixed-point accumulators (shaders/voxelize/sums.glsl): radiance rgb, fragment "
+                           "count, albedo rgb and normal xyz, ten grids side by side along x"});
         d.internal({.name = "lamp_field", .format = Format::RG16F, .size = SizeRule::fixed(kLampFieldSide, kLampFieldSide),
                     .doc = "lamp_model field: the lamp's vector irradiance over (distance from its axis, height)"});
         d.param(intChoiceParam("resolution", 64, {32, 64, 128}, "voxels per side over [-1,1]^3"))
@@ -138,7 +140,7 @@ public:
         const kiln::TextureRef& out = ctx.output("radiance");
         const int res = out.width;
 
-        for (const Sum& sum : kSums) glClearTexImage(ctx.internal(sum.internal).id, 0, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
+        glClearTexImage(ctx.internal("sums").id, 0, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
 
         rasterize(ctx, raster, res, particles && !splatParticles, !splatFireballs, !splatTumblers);
         if (splatter && !splat(ctx, splatter, res, splatParticles, splatFireballs)) return;
@@ -244,20 +246,10 @@ private:
         glDispatchCompute(groups, groups, groups);
     }
 
-    // The accumulators: each internal texture and its image in shaders/voxelize/sums.glsl.
-    // The normal's are signed: R32UI storage viewed as R32I (same size class).
-    struct Sum {
-        const char* internal;
-        const char* image;
-    };
-    static constexpr Sum kSums[] = {{"sum_r", "u_sumR"},       {"sum_g", "u_sumG"},       {"sum_b", "u_sumB"},
-                                    {"count", "u_count"},      {"albedo_r", "u_albedoR"}, {"albedo_g", "u_albedoG"},
-                                    {"albedo_b", "u_albedoB"}, {"normal_x", "u_normalX"}, {"normal_y", "u_normalY"},
-                                    {"normal_z", "u_normalZ"}};
+    // The accumulators: one volume, kSumChannels grids along x (shaders/voxelize/sums.glsl).
+    static constexpr int kSumChannels = 10;
     static void bindSums(kiln::PassContext& ctx, GLuint program, GLenum access) {
-        for (const Sum& sum : kSums)
-            kiln::gl::bindImage(program, sum.image, ctx.internal(sum.internal).id, 0, true, access,
-                                std::string_view(sum.internal).starts_with("normal") ? GL_R32I : GL_R32UI);
+        kiln::gl::bindImage(program, "u_sums", ctx.internal("sums").id, 0, true, access, GL_R32UI);
     }
 
     // lamp_model field: the lamp's vector irradiance on its grid (the same builder as

@@ -6,22 +6,22 @@
 // emission.
 layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
 
-#include "sums.glsl"  // the accumulators (image units 0–9) and their fixed-point scales
-layout(rgba16f, binding = 10) uniform writeonly image3D u_radiance;
-layout(rgba8, binding = 11) uniform writeonly image3D u_albedo;
-layout(rgba16f, binding = 12) uniform writeonly image3D u_normal;
+#include "sums.glsl"  // the accumulators (image unit 0) and their fixed-point scales
+layout(rgba16f, binding = 1) uniform writeonly image3D u_radiance;
+layout(rgba8, binding = 2) uniform writeonly image3D u_albedo;
+layout(rgba16f, binding = 3) uniform writeonly image3D u_normal;
 
 void main() {
     ivec3 v = ivec3(gl_GlobalInvocationID);
     if (any(greaterThanEqual(v, imageSize(u_radiance)))) return;
-    uint n = imageLoad(u_count, v).r;
+    uint n = loadSum(v, kCount);
     vec4 value = vec4(0.0), albedo = vec4(0.0), normal = vec4(0.0);
     if (n > 0u) {
-        vec3 sum = vec3(imageLoad(u_sumR, v).r, imageLoad(u_sumG, v).r, imageLoad(u_sumB, v).r);
+        vec3 sum = vec3(loadSum(v, kSumR), loadSum(v, kSumG), loadSum(v, kSumB));
         value = vec4(sum / (kFixedScale * float(n)), 1.0);
-        vec3 a = vec3(imageLoad(u_albedoR, v).r, imageLoad(u_albedoG, v).r, imageLoad(u_albedoB, v).r);
+        vec3 a = vec3(loadSum(v, kAlbedoR), loadSum(v, kAlbedoG), loadSum(v, kAlbedoB));
         albedo = vec4(a / (kUnitScale * float(n)), 1.0);
-        vec3 m = vec3(imageLoad(u_normalX, v).r, imageLoad(u_normalY, v).r, imageLoad(u_normalZ, v).r);
+        vec3 m = vec3(int(loadSum(v, kNormalX)), int(loadSum(v, kNormalY)), int(loadSum(v, kNormalZ)));
         normal = vec4(m / (kUnitScale * float(n)), 1.0);
     }
     imageStore(u_radiance, v, value);

@@ -3,16 +3,17 @@
 // fragments (voxelize.frag) and the splatted particles (splat.comp); resolve.comp
 // (which includes this file for the same layout and scales) divides them. Surfaces (not the particles, which only emit) also add their albedo and
 // normal: what voxel_mip's bounces reflect, and towards where.
-layout(r32ui, binding = 0) uniform coherent uimage3D u_sumR;
-layout(r32ui, binding = 1) uniform coherent uimage3D u_sumG;
-layout(r32ui, binding = 2) uniform coherent uimage3D u_sumB;
-layout(r32ui, binding = 3) uniform coherent uimage3D u_count;
-layout(r32ui, binding = 4) uniform coherent uimage3D u_albedoR;
-layout(r32ui, binding = 5) uniform coherent uimage3D u_albedoG;
-layout(r32ui, binding = 6) uniform coherent uimage3D u_albedoB;
-layout(r32i, binding = 7) uniform coherent iimage3D u_normalX;
-layout(r32i, binding = 8) uniform coherent iimage3D u_normalY;
-layout(r32i, binding = 9) uniform coherent iimage3D u_normalZ;
+// All ten in one R32UI volume, kSumChannels grids side by side along x: one image unit
+// where ten would pass OpenGL 4.5's guaranteed 8 (NVIDIA's limit, and its fragment
+// shaders' too). The normal's sums are signed: two's-complement adds wrap alike in a uint.
+layout(r32ui, binding = 0) uniform coherent uimage3D u_sums;
+const int kSumR = 0, kSumG = 1, kSumB = 2, kCount = 3, kAlbedoR = 4, kAlbedoG = 5, kAlbedoB = 6, kNormalX = 7,
+          kNormalY = 8, kNormalZ = 9, kSumChannels = 10;
+
+// Voxel v's texel of one channel (the grid's side: the volume's height).
+ivec3 sumTexel(ivec3 v, int channel) { return ivec3(v.x + channel * imageSize(u_sums).y, v.yz); }
+void addToSum(ivec3 v, int channel, uint value) { imageAtomicAdd(u_sums, sumTexel(v, channel), value); }
+uint loadSum(ivec3 v, int channel) { return imageLoad(u_sums, sumTexel(v, channel)).r; }
 
 const float kFixedScale = 512.0;
 const float kMaxRadiance = 2048.0;
@@ -22,10 +23,10 @@ uvec3 toFixedRadiance(vec3 radiance) { return uvec3(clamp(radiance, 0.0, kMaxRad
 
 // One fragment's radiance (toFixedRadiance) added to voxel v.
 void addToVoxel(ivec3 v, uvec3 fixedRgb) {
-    imageAtomicAdd(u_sumR, v, fixedRgb.r);
-    imageAtomicAdd(u_sumG, v, fixedRgb.g);
-    imageAtomicAdd(u_sumB, v, fixedRgb.b);
-    imageAtomicAdd(u_count, v, 1u);
+    addToSum(v, kSumR, fixedRgb.r);
+    addToSum(v, kSumG, fixedRgb.g);
+    addToSum(v, kSumB, fixedRgb.b);
+    addToSum(v, kCount, 1u);
 }
 
 // A surface fragment: its radiance, and its albedo and unit normal.
@@ -33,10 +34,10 @@ void addSurfaceToVoxel(ivec3 v, uvec3 fixedRgb, vec3 albedo, vec3 n) {
     addToVoxel(v, fixedRgb);
     uvec3 a = uvec3(clamp(albedo, 0.0, 1.0) * kUnitScale + 0.5);
     ivec3 d = ivec3(round(clamp(n, -1.0, 1.0) * kUnitScale));
-    imageAtomicAdd(u_albedoR, v, a.r);
-    imageAtomicAdd(u_albedoG, v, a.g);
-    imageAtomicAdd(u_albedoB, v, a.b);
-    imageAtomicAdd(u_normalX, v, d.x);
-    imageAtomicAdd(u_normalY, v, d.y);
-    imageAtomicAdd(u_normalZ, v, d.z);
+    addToSum(v, kAlbedoR, a.r);
+    addToSum(v, kAlbedoG, a.g);
+    addToSum(v, kAlbedoB, a.b);
+    addToSum(v, kNormalX, uint(d.x));
+    addToSum(v, kNormalY, uint(d.y));
+    addToSum(v, kNormalZ, uint(d.z));
 }

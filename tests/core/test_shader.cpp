@@ -92,6 +92,52 @@ TEST_CASE("a valid program with nested includes compiles and links", "[shader][g
     CHECK(b.dependencies.size() == 5);
 }
 
+// llvmpipe links these (32 image units); NVIDIA's driver refuses image unit 8 and up,
+// which is how voxelize's ten accumulator images once failed there and nowhere here.
+TEST_CASE("a program that uses more than OpenGL 4.5 guarantees links, with a warning naming the file",
+          "[shader][gl]") {
+    REQUIRE(test::ensureHeadlessContext());
+    const ShaderLibrary lib({TEST_SHADER_DIR, KILN_SOURCE_DIR "/shaders"});
+    auto build = [&](std::vector<std::string> stages) {
+        ProgramBuild b = buildProgram(lib, {std::move(stages), {}, "portability"});
+        INFO(b.errorText());
+        REQUIRE(b.ok());
+        return b;
+    };
+    auto text = [](const ProgramBuild& b) {
+        std::string all;
+        for (auto& issue : b.portability) all += issue.toString() + "\n";
+        return all;
+    };
+
+    ProgramBuild unit9 = build({"portability/image_unit_9.comp"});
+    INFO(text(unit9));
+    REQUIRE(unit9.portability.size() == 1);
+    // Where it is declared, as a compile error would say it.
+    CHECK(unit9.portability[0].file == "shaders/portability/image_unit_9.comp");
+    CHECK(unit9.portability[0].line == 5);
+    CHECK_THAT(unit9.portability[0].message, Catch::Contains("'u_tenth' is bound to image unit 9") &&
+                                                 Catch::Contains("guarantees 0-7 only (NVIDIA"));
+
+    // Nine images: the ninth's unit (8) and the fragment stage's count, each named, and
+    // attributed to the fragment shader, not the vertex shader listed first.
+    ProgramBuild nine = build({"common/fullscreen.vert", "portability/nine_images.frag"});
+    INFO(text(nine));
+    REQUIRE(nine.portability.size() == 2);
+    for (auto& issue : nine.portability) CHECK(issue.file == "shaders/portability/nine_images.frag");
+    CHECK_THAT(text(nine), Catch::Contains("'u_images[8]' is bound to image unit 8"));
+    CHECK_THAT(text(nine), Catch::Contains("uses 9 images; OpenGL 4.5 guarantees a fragment shader 8 only"));
+
+    ProgramBuild storage8 = build({"portability/storage_binding_8.comp"});
+    INFO(text(storage8));
+    REQUIRE(storage8.portability.size() == 1);
+    CHECK(storage8.portability[0].line == 4);
+    CHECK_THAT(storage8.portability[0].message, Catch::Contains("storage block 'Counts' is bound to storage buffer binding 8"));
+
+    // At the limit, not over it: nothing.
+    CHECK(text(build({"portability/eight_images.comp"})).empty());
+}
+
 TEST_CASE("program cache: bounded, least recently used goes, an evicted variant rebuilds", "[shader][gl]") {
     REQUIRE(test::ensureHeadlessContext());
     const ShaderLibrary lib = library();

@@ -181,16 +181,16 @@ try:
                                capture_output=True, text=True).stderr.strip()
     check(differing == "0", "the saved gbuffer.albedo equals the headless dump's, pixel for pixel (%s differ)" % differing)
 
-    # 2. An integer texture (R32UI voxel counts) is not black: the fitted range is > 0.
+    # 2. An integer texture (R32UI voxel sums and counts) is not black: the fitted range is > 0.
     click("texture-filter")
-    sh("xdotool", "type", "--window", WINDOW, "count")
+    sh("xdotool", "type", "--window", WINDOW, "sums")
     # The whole word first: the characters reach ImGui one a frame, and the rows move as
-    # the filter narrows (a click aimed after "c" landed on another row after "count").
-    wait_for(lambda p: p["texture_filter"] == "count" and "texture:voxelize.count" in p["widgets"],
-             "voxelize.count in the list filtered by \"count\"")
-    click("texture:voxelize.count")
-    p = wait_for(lambda p: p["viewed"] == "voxelize.count" and "fit" in p, "a fit of voxelize.count")
-    check(p["fit"][1] >= 1, "voxelize.count (R32UI) fits to a range with counts: %s" % p["fit"])
+    # the filter narrows (a click aimed after "s" landed on another row after "sums").
+    wait_for(lambda p: p["texture_filter"] == "sums" and "texture:voxelize.sums" in p["widgets"],
+             "voxelize.sums in the list filtered by \"sums\"")
+    click("texture:voxelize.sums")
+    p = wait_for(lambda p: p["viewed"] == "voxelize.sums" and "fit" in p, "a fit of voxelize.sums")
+    check(p["fit"][1] >= 1, "voxelize.sums (R32UI) fits to a range with counts: %s" % p["fit"])
     # ... and its 64-bin histogram is drawn under the image: as wide as the window, with
     # bars (ImGui's plot colour, orange) in it. It was 1 px wide and empty.
     p = wait_for(lambda p: "texture-histogram" in p["widgets"], "the histogram")
@@ -302,7 +302,7 @@ try:
     click("texture-filter")
     sh("xdotool", "key", "--window", WINDOW, "ctrl+a")
     sh("xdotool", "type", "--window", WINDOW, "--delay", "1", "albedo")
-    p = wait_for(lambda p: "texture:gbuffer.albedo" in p["widgets"] and "texture:voxelize.count" not in p["widgets"],
+    p = wait_for(lambda p: "texture:gbuffer.albedo" in p["widgets"] and "texture:voxelize.sums" not in p["widgets"],
                  "the filter replaced by \"albedo\"", 120)
     check("texture:gbuffer.albedo" in p["widgets"], "Ctrl+A and \"albedo\" typed in one slow frame (%.0f ms) replace the filter"
           % p["frame_ms"])

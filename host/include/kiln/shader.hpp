@@ -74,6 +74,10 @@ struct ProgramDesc {
 struct ProgramBuild {
     gl::ProgramHandle program;        // empty on failure
     std::vector<ShaderError> errors;
+    // What the program uses beyond OpenGL 4.5's guaranteed minimums (image units and
+    // storage blocks: 8): it links here (llvmpipe allows 32) but not on a driver at the
+    // minimum, as NVIDIA's image units are. Not an error: the program runs here.
+    std::vector<ShaderError> portability;
     std::vector<std::filesystem::path> dependencies;  // every file of every stage
     bool ok() const { return bool(program); }
     std::string errorText() const;    // errors one per line
