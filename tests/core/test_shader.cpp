@@ -4,6 +4,8 @@
 
 #include <filesystem>
 #include <fstream>
+#include <regex>
+#include <sstream>
 
 #include "kiln/shader.hpp"
 #include "run/program_cache.hpp"
@@ -136,6 +138,53 @@ TEST_CASE("a program that uses more than OpenGL 4.5 guarantees links, with a war
 
     // At the limit, not over it: nothing.
     CHECK(text(build({"portability/eight_images.comp"})).empty());
+}
+
+namespace {
+// A derivative after a fragment shader's first `discard`, as "line: text" (empty when
+// none): dFdx/dFdy/fwidth, or a texture() lookup, which takes its level of detail from
+// derivatives. GLSL leaves them undefined once lanes of the 2x2 quad may have left:
+// llvmpipe only masks a discarded lane and computes them right anyway, NVIDIA's driver
+// does not (voxelize.frag's depth span did this, and the H200's voxels lost the steep
+// parts of the tumblers' shells). Text only: a helper from an #include that takes a
+// derivative is not followed.
+std::vector<std::string> derivativesAfterDiscard(const std::string& source) {
+    static const std::regex discard(R"(\bdiscard\b)");
+    static const std::regex derivative(R"(\b(dFdx\w*|dFdy\w*|fwidth\w*|texture|textureOffset|textureProj)\s*\()");
+    std::vector<std::string> found;
+    std::istringstream lines(source);
+    std::string line;
+    bool discarded = false;
+    for (int number = 1; std::getline(lines, line); ++number) {
+        const std::string code = line.substr(0, line.find("//"));
+        if (discarded && std::regex_search(code, derivative)) found.push_back(std::to_string(number) + ": " + line);
+        discarded = discarded || std::regex_search(code, discard);
+    }
+    return found;
+}
+}  // namespace
+
+TEST_CASE("no shipped fragment shader takes a derivative after it may discard", "[shader]") {
+    // The check itself, on voxelize.frag's old order and its fixed one.
+    const std::string before = "void main() {\n    if (outside) discard;\n    float z = v_world.y;\n"
+                               "    float span = abs(dFdx(z)) + abs(dFdy(z));  // dFdx after discard\n}\n";
+    const std::string after = "void main() {\n    float span = fwidth(v_world.y);\n    if (outside) discard;\n"
+                              "    o = texelFetch(u_t, ivec2(0), 0) + textureLod(u_t, uv, 0.0);\n}\n";
+    CHECK(derivativesAfterDiscard(before) == std::vector<std::string>{"4:     float span = abs(dFdx(z)) + abs(dFdy(z));  // dFdx after discard"});
+    CHECK(derivativesAfterDiscard(after).empty());
+    CHECK(derivativesAfterDiscard("if (a) discard;\nvec4 c = texture(u_wood, uv);\n").size() == 1);
+
+    int fragmentShaders = 0;
+    for (const auto& entry : fs::recursive_directory_iterator(fs::path(KILN_SOURCE_DIR) / "shaders")) {
+        if (entry.path().extension() != ".frag") continue;
+        std::ifstream in(entry.path());
+        std::stringstream text;
+        text << in.rdbuf();
+        INFO(entry.path().string());
+        CHECK(derivativesAfterDiscard(text.str()).empty());
+        ++fragmentShaders;
+    }
+    CHECK(fragmentShaders >= 10);
 }
 
 TEST_CASE("program cache: bounded, least recently used goes, an evicted variant rebuilds", "[shader][gl]") {
