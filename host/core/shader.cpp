@@ -290,6 +290,7 @@ std::string infoLog(GLuint object, bool isProgram) {
     s.resize(std::strlen(s.c_str()));
     return s;
 }
+
 // OpenGL 4.5 core's guaranteed minimums (the specification's table of implementation
 // limits) for what a shader names by binding: GL_MAX_IMAGE_UNITS and
 // GL_MAX_COMBINED_IMAGE_UNIFORMS, GL_MAX_{FRAGMENT,COMPUTE}_IMAGE_UNIFORMS,
@@ -354,20 +355,21 @@ std::vector<BoundResource> boundResources(GLuint program, GLenum interface) {
     return out;
 }
 
-// Where a resource is declared: the first line of a stage's source that uses it with
-// a binding qualifier ("... binding = N ... u_name" or a block "buffer Name"), as that
-// stage's file and line; else the stage's own file.
+// A stage that compiled, with its preprocessed source (for file:line lookups).
 struct CompiledStage {
     GLenum stage;
     PreprocessedSource source;
 };
 
+// Where a resource is declared: the first line of a stage's source that names it with
+// a binding qualifier ("... binding = N ... u_name" or a block "buffer Name"), as that
+// stage's file and line; else the stage's own file.
 ShaderError declaredAt(const std::vector<CompiledStage>& stages, const std::vector<GLenum>& usedBy,
                        const std::string& resource) {
     const std::string name = resource.substr(0, resource.find('['));
     auto isIdentifier = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; };
     for (const CompiledStage& stage : stages) {
-        // (Mesa reports no referencing stage for storage blocks: then any stage.)
+        // No referencing stage reported (Mesa's answer for a storage block here): any stage.
         if (!usedBy.empty() && std::find(usedBy.begin(), usedBy.end(), stage.stage) == usedBy.end()) continue;
         const PreprocessedSource& src = stage.source;
         std::istringstream text(src.text);

@@ -106,6 +106,17 @@
 //   program of the pass: bind for each program before it runs. Reserved by the host:
 //   uniform block binding 0 (common/frame.glsl) and shader storage binding 0 (the
 //   instances of common/instances.glsl) while drawScene runs.
+//   Stay within what OpenGL 4.5 guarantees every driver: image units 0–7 and storage
+//   buffer bindings 0–7, at most 8 of each in a fragment or compute shader. llvmpipe
+//   links programs past that (32 image units); NVIDIA's driver does not (its image
+//   units stop at 8). The host logs a program that goes past them as a portability
+//   warning at the declaration's file:line (Runtime::portabilityWarnings()).
+//
+// DERIVATIVES
+//   Take dFdx/dFdy/fwidth, and texture() lookups that pick their mip level from them,
+//   before a fragment shader's first `discard`: after it they are undefined. llvmpipe
+//   still computes them right and NVIDIA does not, so only a GPU shows the bug
+//   (tests/core/test_shader.cpp checks the shipped shaders' text for it).
 //
 // GL STATE
 //   Before each pass the host resets: framebuffer 0 and the viewport to the output
@@ -150,9 +161,9 @@ namespace kiln {
 // Bump when anything in this header (or what it includes) changes layout or vtables,
 // or when what the host does for a pass changes (6: the host issues the barrier
 // between passes; 7: GpuFrame::boxWalls; 8: PassContext::keepRunning; 9:
-// SizeRule::capSource and Lod::Medium), so a module built for other terms is refused
-// by name, not run.
-inline constexpr uint32_t kPassAbiVersion = 9;
+// SizeRule::capSource and Lod::Medium; 10: ProgramBuild::portability), so a module
+// built for other terms is refused by name, not run.
+inline constexpr uint32_t kPassAbiVersion = 10;
 
 struct TextureRef {
     GLuint id = 0;
