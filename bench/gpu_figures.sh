@@ -7,7 +7,10 @@
 set -eu
 bin=${1:-build/bin}
 out=${2:-bench-out/gpu}
-mkdir -p "$out"
+# The path-traced references (EXR, megabytes each at 720²) beside the results, not in
+# them, so OUT_DIR stays CSVs and plots and a rerun reuses them.
+cache=$out.reference-cache
+mkdir -p "$out" "$cache"
 before=bench/pipelines/default_before_22.json
 "$bin/kiln-bench-render" --size 720x720 --frames 30 --repeats 7 --pipeline "$before" --pipeline pipelines/default.json \
     --pipeline pipelines/course.json --out "$out/render_720"
@@ -21,5 +24,5 @@ knobs="--sweep cone_trace.trace_samples=32,48,64,96,128 --sweep composite.pcf=1,
 for t in 0 0.5; do
     # shellcheck disable=SC2086
     "$bin/kiln-bench-quality" --size 720x720 --spp 1024 --time "$t" --repeats 3 --out "$out/quality_720_t$t" \
-        --also "$before" $knobs
+        --cache "$cache" --also "$before" $knobs
 done
