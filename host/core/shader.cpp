@@ -327,23 +327,28 @@ std::vector<BoundResource> boundResources(GLuint program, GLenum interface) {
         std::string name(size_t(std::max(nameLength, 1)), '\0');
         glGetProgramResourceName(program, interface, GLuint(i), nameLength, nullptr, name.data());
         name.resize(std::strlen(name.c_str()));
-        std::vector<GLenum> stages;
-        for (const StageRef& ref : kStageRefs) {
-            GLint used = 0;
-            glGetProgramResourceiv(program, interface, GLuint(i), 1, &ref.referencedBy, 1, nullptr, &used);
-            if (used) stages.push_back(ref.stage);
-        }
+        auto referencingStages = [&] {
+            std::vector<GLenum> stages;
+            for (const StageRef& ref : kStageRefs) {
+                GLint used = 0;
+                glGetProgramResourceiv(program, interface, GLuint(i), 1, &ref.referencedBy, 1, nullptr, &used);
+                if (used) stages.push_back(ref.stage);
+            }
+            return stages;
+        };
         if (interface == GL_SHADER_STORAGE_BLOCK) {
             const GLenum prop = GL_BUFFER_BINDING;
             GLint binding = 0;
             glGetProgramResourceiv(program, interface, GLuint(i), 1, &prop, 1, nullptr, &binding);
-            out.push_back({name, binding, stages});
+            out.push_back({name, binding, referencingStages()});
             continue;
         }
+        // Every other uniform (most of them) is passed over before its stages are asked.
         const GLenum props[] = {GL_TYPE, GL_LOCATION, GL_ARRAY_SIZE};
         GLint values[3] = {};
         glGetProgramResourceiv(program, interface, GLuint(i), 3, props, 3, nullptr, values);
         if (!isImageType(values[0]) || values[1] < 0) continue;
+        const std::vector<GLenum> stages = referencingStages();
         const bool array = name.ends_with("[0]");
         if (array) name.resize(name.size() - 3);
         for (GLint element = 0; element < std::max(values[2], 1); ++element) {

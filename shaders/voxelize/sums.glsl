@@ -3,12 +3,13 @@
 // fragments (voxelize.frag) and the splatted particles (splat.comp); resolve.comp
 // (which includes this file for the same layout and scales) divides them. Surfaces (not the particles, which only emit) also add their albedo and
 // normal: what voxel_mip's bounces reflect, and towards where.
-// All ten in one R32UI volume, kSumChannels grids side by side along x: one image unit
-// where ten would pass OpenGL 4.5's guaranteed 8 (NVIDIA's limit, and its fragment
-// shaders' too). The normal's sums are signed: two's-complement adds wrap alike in a uint.
+// All ten in one R32UI volume, ten grids side by side along x (its width is the grid's
+// side times voxelize.cpp's kSumChannels): one image unit where ten would pass OpenGL
+// 4.5's guaranteed 8 (NVIDIA's limit, and its fragment shaders' too). The normal's sums
+// are signed: two's-complement adds wrap alike in a uint.
 layout(r32ui, binding = 0) uniform coherent uimage3D u_sums;
 const int kSumR = 0, kSumG = 1, kSumB = 2, kCount = 3, kAlbedoR = 4, kAlbedoG = 5, kAlbedoB = 6, kNormalX = 7,
-          kNormalY = 8, kNormalZ = 9, kSumChannels = 10;
+          kNormalY = 8, kNormalZ = 9;
 
 // Voxel v's texel of one channel (the grid's side: the volume's height).
 ivec3 sumTexel(ivec3 v, int channel) { return ivec3(v.x + channel * imageSize(u_sums).y, v.yz); }
