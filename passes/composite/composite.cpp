@@ -60,6 +60,9 @@ public:
             .param(intChoiceParam("lamp_field_size", 256, {32, 64, 128, 256, 512},
                                   "lamp_model field: nodes per side of the lamp's axisymmetric grid (distance from "
                                   "its axis x height; 256: 5.5 x 7.8 mm apart, 256 KiB)"))
+            .param(boolParam("lamp_through_fire", false,
+                             "multiply the lamp's light by `indirect`'s alpha: its transmittance through the "
+                             "fireballs and particles, from cone_trace with `fire` bound (voxelize.fire_cover on)"))
             .param(intChoiceParam("lamp_samples", 32, {4, 8, 16, 32, 64},
                                   "vertices of the lamp's silhouette (contour) or quadrature points over its cap (points)"));
         d.reads = kSceneLight | kSceneCamera | kSceneFireballs;
@@ -77,6 +80,7 @@ public:
                                             {"KILN_LAMP_NEAR_FIELD", nearField ? "1" : "0"},
                                             {"KILN_PCF", std::to_string(ctx.getInt("pcf"))},
                                             {"KILN_PCSS", ctx.getEnum("shadow_filter") == "pcss" ? "1" : "0"},
+                                            {"KILN_LAMP_THROUGH_FIRE", ctx.getBool("lamp_through_fire") ? "1" : "0"},
                                             {"KILN_FIREBALLS_ANALYTIC", ctx.getEnum("fireball_light") == "analytic" ? "1" : "0"}}});
         };
         GLuint program = variant(false);
@@ -85,6 +89,12 @@ public:
         if (lampModel == "field" && !buildLampField(ctx)) return;
         GLuint nearProgram = nearField ? variant(true) : 0;
         if (nearField && !nearProgram) return;
+        if (lampModel == "traced" && ctx.getBool("lamp_through_fire"))
+            return ctx.fail("lamp_model traced and lamp_through_fire both read `indirect`'s alpha (the lamp, or its "
+                            "transmittance through the fire): pick one");
+        if (ctx.getBool("lamp_through_fire") && !ctx.isBound("indirect"))
+            return ctx.fail("lamp_through_fire reads the lamp's transmittance through the fire from `indirect` "
+                            "(cone_trace.indirect with cone_trace's `fire` bound): bind it, or turn it off");
         if (lampModel == "traced" && !ctx.isBound("indirect"))
             return ctx.fail("lamp_model traced reads the lamp from `indirect` (cone_trace.indirect with cone_trace's "
                             "`lamp` on): bind it, or use lamp_model contour");

@@ -42,6 +42,10 @@
 //      splat 1.4. Not the default: against the reference the floor next to the tumblers
 //      is worse (relMSE 0.0124 against the mesh's 0.0114 at 256², t = 0), though every
 //      region's mean light is closer (the floor's indirect light 0.966 -> 1.003×).
+//   The particles' cover on request (fire_cover on): a compute pass (voxelize/fire_cover.comp)
+//      shares each particle's cross-section among the voxels it overlaps, resolved into
+//      `fire` (the optical depth across each voxel, with mips) through which cone_trace
+//      marches the lamp's light: the fire rising round the dome hides part of it.
 //   4. A compute pass (4³ groups) resolves sum/count into `radiance`: rgb = the mean
 //      outgoing radiance, a = occupancy (1 where any fragment landed, else 0). The
 //      colour is premultiplied by the occupancy (empty voxels are 0,0,0,0), which is
@@ -73,11 +77,16 @@ public:
             .output({.name = "albedo", .kind = TextureKind::Color3D, .format = Format::RGBA8, .size = cube,
                      .doc = "rgb = the surfaces' mean albedo (particles count as 0), a = occupancy"})
             .output({.name = "normal", .kind = TextureKind::Color3D, .format = Format::RGBA16F, .size = cube,
-                     .doc = "xyz = the surfaces' mean unit normal (shorter where they disagree), a = occupancy"});
+                     .doc = "xyz = the surfaces' mean unit normal (shorter where they disagree), a = occupancy"})
+            .output({.name = "fire", .kind = TextureKind::Color3D, .format = Format::R16F, .size = cube,
+                     .mips = kFullMipChain,
+                     .doc = "fire_cover on: the fire particles' optical depth across each voxel (their "
+                            "cross-sections per voxel face); mips: the mean",
+                     .producedWhen = {"fire_cover", {"on"}}});
         d.internal({.name = "sums", .kind = TextureKind::Color3D, .format = Format::R32UI,
                     .size = SizeRule::fromParam("resolution", 1.0f, kSumChannels),
                     .doc = "the fixed-point accumulators (shaders/voxelize/sums.glsl): radiance rgb, fragment "
-                           "count, albedo rgb and normal xyz, ten grids side by side along x"});
+                           "count, albedo rgb, normal xyz and the particles' cover, eleven grids side by side along x"});
         d.internal({.name = "lamp_field", .format = Format::RG16F, .size = SizeRule::fixed(kLampFieldSide, kLampFieldSide),
                     .doc = "lamp_model field: the lamp's vector irradiance over (distance from its axis, height)"});
         d.param(intChoiceParam("resolution", 64, {32, 64, 128}, "voxels per side over [-1,1]^3"))
@@ -113,7 +122,10 @@ public:
                              "silhouette's contour integral (16 vertices), 32 quadrature points over the cap, or "
                              "one lookup in its vector irradiance on a 256² axisymmetric grid (the `lamp_field` "
                              "internal, built when the lamp changes; shaders/common/lamp_field.comp)"))
-            .param(floatParam("shadow_bias", 0.002f, 0.0, 0.05, "depth bias of the (hard) shadow test"));
+            .param(floatParam("shadow_bias", 0.002f, 0.0, 0.05, "depth bias of the (hard) shadow test"))
+            .param(enumParam("fire_cover", "off", {"off", "on"},
+                             "on: `fire` holds how much light the fire's particles stop in each voxel, for "
+                             "cone_trace's `fire` (the lamp's light through the fire)"));
         d.reads = kSceneStatic | kSceneBodies | kSceneParticles | kSceneLight;
         return d;
     }
@@ -127,14 +139,18 @@ public:
                                     {"KILN_LAMP_FIELD", field ? "1" : "0"}};
         GLuint raster = ctx.program({.stages = {"voxelize/voxelize.vert", "voxelize/voxelize.geom", "voxelize/voxelize.frag"},
                                      .defines = lamp});
-        GLuint resolve = ctx.program({.stages = {"voxelize/resolve.comp"}});
+        const bool fireCover = ctx.getEnum("fire_cover") == "on";
+        GLuint resolve = ctx.program({.stages = {"voxelize/resolve.comp"},
+                                      .defines = {{"KILN_FIRE_COVER", fireCover ? "1" : "0"}}});
+        GLuint coverer = fireCover ? ctx.program({.stages = {"voxelize/fire_cover.comp"}}) : 0;
         const bool particles = ctx.getBool("particles");
         const bool splatParticles = particles && ctx.getEnum("particle_mode") == "splat";
         const bool splatFireballs = ctx.getEnum("fireball_mode") == "splat";
         GLuint splatter = splatParticles || splatFireballs ? ctx.program({.stages = {"voxelize/splat.comp"}, .defines = lamp}) : 0;
         const bool splatTumblers = ctx.getEnum("tumbler_mode") == "splat";
         GLuint tumblerSplatter = splatTumblers ? ctx.program({.stages = {"voxelize/tumblers.comp"}, .defines = lamp}) : 0;
-        if (!raster || !resolve || ((splatParticles || splatFireballs) && !splatter) || (splatTumblers && !tumblerSplatter))
+        if (!raster || !resolve || ((splatParticles || splatFireballs) && !splatter) ||
+            (splatTumblers && !tumblerSplatter) || (fireCover && !coverer))
             return;
         if (field && !buildLampField(ctx)) return;
         const kiln::TextureRef& out = ctx.output("radiance");
@@ -145,7 +161,12 @@ public:
         rasterize(ctx, raster, res, particles && !splatParticles, !splatFireballs, !splatTumblers);
         if (splatter && !splat(ctx, splatter, res, splatParticles, splatFireballs)) return;
         if (tumblerSplatter) splatTumblerShapes(ctx, tumblerSplatter, res);
-        resolveSums(ctx, resolve, out, res);
+        if (coverer && !coverFire(ctx, coverer, res)) return;
+        resolveSums(ctx, resolve, out, res, fireCover);
+        if (fireCover) {  // the mips from the image stores (no barrier bit names glGenerateMipmap)
+            glMemoryBarrier(GL_ALL_BARRIER_BITS);
+            glGenerateTextureMipmap(ctx.output("fire").id);
+        }
     }
 
 private:
@@ -218,6 +239,21 @@ private:
         return true;
     }
 
+    // fire_cover: the particles' cross-sections into the sums (cone_trace takes the
+    // fireballs exactly). False when the pass failed.
+    static bool coverFire(kiln::PassContext& ctx, GLuint coverer, int res) {
+        const kiln::SceneView& scene = ctx.scene();
+        const uint32_t count = scene.count(kiln::kSceneParticles);
+        if (count == 0) return true;
+        glUseProgram(coverer);
+        bindSums(ctx, coverer, GL_READ_WRITE);
+        glUniform1ui(glGetUniformLocation(coverer, "u_first"), scene.firstInstance(kiln::kSceneParticles));
+        glUniform1ui(glGetUniformLocation(coverer, "u_sphereCount"), count);
+        glUniform1i(glGetUniformLocation(coverer, "u_res"), res);
+        glDispatchCompute((count + 63) / 64, 1, 1);
+        return true;
+    }
+
     // The tumblers from their exact shape (tumbler_mode splat): one invocation per voxel of
     // the cube around each one's bounding ball (half its height plus its lower radius
     // from the axis' midpoint), a row of groups per tumbler.
@@ -235,19 +271,20 @@ private:
     }
 
     // 4: the sums' averages into the outputs.
-    static void resolveSums(kiln::PassContext& ctx, GLuint resolve, const kiln::TextureRef& out, int res) {
+    static void resolveSums(kiln::PassContext& ctx, GLuint resolve, const kiln::TextureRef& out, int res, bool fireCover) {
         glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
         glUseProgram(resolve);
         bindSums(ctx, resolve, GL_READ_ONLY);
         kiln::gl::bindImage(resolve, "u_radiance", out.id, 0, true, GL_WRITE_ONLY, GL_RGBA16F);
         kiln::gl::bindImage(resolve, "u_albedo", ctx.output("albedo").id, 0, true, GL_WRITE_ONLY, GL_RGBA8);
         kiln::gl::bindImage(resolve, "u_normal", ctx.output("normal").id, 0, true, GL_WRITE_ONLY, GL_RGBA16F);
+        if (fireCover) kiln::gl::bindImage(resolve, "u_fire", ctx.output("fire").id, 0, true, GL_WRITE_ONLY, GL_R16F);
         const GLuint groups = GLuint((res + 3) / 4);
         glDispatchCompute(groups, groups, groups);
     }
 
     // The accumulators: one volume, kSumChannels grids along x (shaders/voxelize/sums.glsl).
-    static constexpr int kSumChannels = 10;
+    static constexpr int kSumChannels = 11;
     static void bindSums(kiln::PassContext& ctx, GLuint program, GLenum access) {
         kiln::gl::bindImage(program, "u_sums", ctx.internal("sums").id, 0, true, access, GL_R32UI);
     }

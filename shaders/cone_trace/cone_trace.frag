@@ -2,11 +2,18 @@
 // Per-pixel diffuse cone tracing: every pixel (stride 1), or one pixel per stride×stride
 // block: then pixel ij traces the G-buffer texel stride·ij + stride/2 (traceTexel in
 // upsample.glsl) and also writes that surface's plane for upsample.frag. Alpha: the
-// cone-traced ambient visibility, or (cone_trace.lamp) the lamp's projected solid angle.
+// cone-traced ambient visibility, or (cone_trace.lamp) the lamp's projected solid angle,
+// or (`fire` bound) the lamp's transmittance through the fire.
 #include "common/frame.glsl"
 #include "trace.glsl"
-#if KILN_LAMP_IN_ALPHA
-#include "common/light.glsl"
+// One #if for both: an #include is spliced once per stage, even into a block the
+// preprocessor then drops, so a second #if including light.glsl again would get nothing.
+#if KILN_LAMP_IN_ALPHA || KILN_HAS_FIRE
+#include "common/shadow.glsl"  // and common/light.glsl
+#endif
+#if KILN_HAS_FIRE
+#include "common/instances.glsl"
+#include "fire.glsl"
 #endif
 #include "upsample.glsl"
 
@@ -82,6 +89,8 @@ void main() {
         // The lamp's unshadowed irradiance ÷ its radiance (smooth on a surface, like the
         // indirect light): traced here at one pixel in stride², upsampled with it.
         o_indirect.a = lampProjectedSolidAngle(p, n);
+#elif KILN_HAS_FIRE
+        o_indirect.a = fireTransmittance(p, n);  // the lamp's light through the fire (fire.glsl)
 #endif
 #if KILN_REUSE
         o_age = vec4(0.0, p);

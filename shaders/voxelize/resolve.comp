@@ -3,13 +3,16 @@
 // Colour premultiplied by occupancy (empty voxels are all zero). The surfaces' mean
 // albedo and mean normal over the same count: a voxel that also holds particles (which
 // reflect nothing) reflects that much less, as its mean radiance is that much more
-// emission.
+// emission. With KILN_FIRE_COVER, the fire's optical depth across each voxel (fire_cover.comp).
 layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
 
 #include "sums.glsl"  // the accumulators (image unit 0) and their fixed-point scales
 layout(rgba16f, binding = 1) uniform writeonly image3D u_radiance;
 layout(rgba8, binding = 2) uniform writeonly image3D u_albedo;
 layout(rgba16f, binding = 3) uniform writeonly image3D u_normal;
+#if KILN_FIRE_COVER
+layout(r16f, binding = 4) uniform writeonly image3D u_fire;
+#endif
 
 void main() {
     ivec3 v = ivec3(gl_GlobalInvocationID);
@@ -27,4 +30,7 @@ void main() {
     imageStore(u_radiance, v, value);
     imageStore(u_albedo, v, albedo);
     imageStore(u_normal, v, normal);
+#if KILN_FIRE_COVER
+    imageStore(u_fire, v, vec4(float(loadSum(v, kFireCover)) / kCoverScale));
+#endif
 }

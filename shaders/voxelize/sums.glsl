@@ -1,15 +1,16 @@
 // The voxelization's accumulators (passes/voxelize/voxelize.cpp, step 3): fixed-point
 // radiance sums and a fragment count per voxel, added to atomically by the rasterized
-// fragments (voxelize.frag) and the splatted particles (splat.comp); resolve.comp
+// fragments (voxelize.frag) and the splatted particles (splat.comp), and the fire's
+// cover (fire_cover.comp); resolve.comp
 // (which includes this file for the same layout and scales) divides them. Surfaces (not the particles, which only emit) also add their albedo and
 // normal: what voxel_mip's bounces reflect, and towards where.
-// All ten in one R32UI volume, ten grids side by side along x (its width is the grid's
+// All in one R32UI volume, grids side by side along x (its width is the grid's
 // side times voxelize.cpp's kSumChannels): one image unit where ten would pass OpenGL
 // 4.5's guaranteed 8 (NVIDIA's limit, and its fragment shaders' too). The normal's sums
 // are signed: two's-complement adds wrap alike in a uint.
 layout(r32ui, binding = 0) uniform coherent uimage3D u_sums;
 const int kSumR = 0, kSumG = 1, kSumB = 2, kCount = 3, kAlbedoR = 4, kAlbedoG = 5, kAlbedoB = 6, kNormalX = 7,
-          kNormalY = 8, kNormalZ = 9;
+          kNormalY = 8, kNormalZ = 9, kFireCover = 10;
 
 // Voxel v's texel of one channel (the grid's side: the volume's height).
 ivec3 sumTexel(ivec3 v, int channel) { return ivec3(v.x + channel * imageSize(u_sums).y, v.yz); }
@@ -19,6 +20,7 @@ uint loadSum(ivec3 v, int channel) { return imageLoad(u_sums, sumTexel(v, channe
 const float kFixedScale = 512.0;
 const float kMaxRadiance = 2048.0;
 const float kUnitScale = 4096.0;   // albedo and normal components (|x| ≤ 1): 2^19 fragments a voxel before overflow
+const float kCoverScale = 4096.0;  // the fire's optical depth across a voxel: up to 2^20 (a particle adds about 0.36)
 
 uvec3 toFixedRadiance(vec3 radiance) { return uvec3(clamp(radiance, 0.0, kMaxRadiance) * kFixedScale + 0.5); }
 
