@@ -143,6 +143,7 @@ public:
         GLuint resolve = ctx.program({.stages = {"voxelize/resolve.comp"},
                                       .defines = {{"KILN_FIRE_COVER", fireCover ? "1" : "0"}}});
         GLuint coverer = fireCover ? ctx.program({.stages = {"voxelize/fire_cover.comp"}}) : 0;
+        GLuint fireMip = fireCover ? ctx.program({.stages = {"voxelize/fire_mip.comp"}}) : 0;
         const bool particles = ctx.getBool("particles");
         const bool splatParticles = particles && ctx.getEnum("particle_mode") == "splat";
         const bool splatFireballs = ctx.getEnum("fireball_mode") == "splat";
@@ -150,7 +151,7 @@ public:
         const bool splatTumblers = ctx.getEnum("tumbler_mode") == "splat";
         GLuint tumblerSplatter = splatTumblers ? ctx.program({.stages = {"voxelize/tumblers.comp"}, .defines = lamp}) : 0;
         if (!raster || !resolve || ((splatParticles || splatFireballs) && !splatter) ||
-            (splatTumblers && !tumblerSplatter) || (fireCover && !coverer))
+            (splatTumblers && !tumblerSplatter) || (fireCover && (!coverer || !fireMip)))
             return;
         if (field && !buildLampField(ctx)) return;
         const kiln::TextureRef& out = ctx.output("radiance");
@@ -163,10 +164,7 @@ public:
         if (tumblerSplatter) splatTumblerShapes(ctx, tumblerSplatter, res);
         if (coverer && !coverFire(ctx, coverer, res)) return;
         resolveSums(ctx, resolve, out, res, fireCover);
-        if (fireCover) {  // the mips from the image stores (no barrier bit names glGenerateMipmap)
-            glMemoryBarrier(GL_ALL_BARRIER_BITS);
-            glGenerateTextureMipmap(ctx.output("fire").id);
-        }
+        if (fireCover) mipFire(ctx, fireMip);
     }
 
 private:
@@ -252,6 +250,19 @@ private:
         glUniform1i(glGetUniformLocation(coverer, "u_res"), res);
         glDispatchCompute((count + 63) / 64, 1, 1);
         return true;
+    }
+
+    // fire_cover: `fire`'s mips, each level the mean of the one below (voxelize/fire_mip.comp).
+    static void mipFire(kiln::PassContext& ctx, GLuint program) {
+        const kiln::TextureRef& fire = ctx.output("fire");
+        glUseProgram(program);
+        for (int level = 1; level < fire.levels; ++level) {
+            glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+            kiln::gl::bindImage(program, "u_finer", fire.id, level - 1, true, GL_READ_ONLY, GL_R16F);
+            kiln::gl::bindImage(program, "u_coarser", fire.id, level, true, GL_WRITE_ONLY, GL_R16F);
+            const GLuint groups = GLuint((std::max(1, fire.width >> level) + 3) / 4);
+            glDispatchCompute(groups, groups, groups);
+        }
     }
 
     // The tumblers from their exact shape (tumbler_mode splat): one invocation per voxel of
