@@ -61,8 +61,9 @@ public:
                                   "lamp_model field: nodes per side of the lamp's axisymmetric grid (distance from "
                                   "its axis x height; 256: 5.5 x 7.8 mm apart, 256 KiB)"))
             .param(boolParam("lamp_through_fire", false,
-                             "multiply the lamp's light by `indirect`'s alpha: its transmittance through the "
-                             "fireballs and particles, from cone_trace with `fire` bound (voxelize.fire_cover on)"))
+                             "multiply the lamp's light by `indirect`'s alpha: the fraction of the lamp seen past "
+                             "the fireballs and particles, from cone_trace with `lamp_transmittance` bound "
+                             "(voxelize's fire_cover on)"))
             .param(intChoiceParam("lamp_samples", 32, {4, 8, 16, 32, 64},
                                   "vertices of the lamp's silhouette (contour) or quadrature points over its cap (points)"));
         d.reads = kSceneLight | kSceneCamera | kSceneFireballs;
@@ -94,7 +95,7 @@ public:
                             "transmittance through the fire): pick one");
         if (ctx.getBool("lamp_through_fire") && !ctx.isBound("indirect"))
             return ctx.fail("lamp_through_fire reads the lamp's transmittance through the fire from `indirect` "
-                            "(cone_trace.indirect with cone_trace's `fire` bound): bind it, or turn it off");
+                            "(cone_trace.indirect with cone_trace's `lamp_transmittance` bound): bind it, or turn it off");
         if (lampModel == "traced" && !ctx.isBound("indirect"))
             return ctx.fail("lamp_model traced reads the lamp from `indirect` (cone_trace.indirect with cone_trace's "
                             "`lamp` on): bind it, or use lamp_model contour");

@@ -6,8 +6,9 @@
 // unshadowed projected solid angle at the traced surface (shaders/common/light.glsl's
 // contour), upsampled with the indirect light for composite's lamp_model traced: smooth
 // on a surface like the indirect light, so a sixteenth of the pixels carry it; or with
-// `fire` bound (voxelize.fire), the lamp's transmittance through the fireballs and
-// particles (shaders/cone_trace/fire.glsl), for composite's lamp_through_fire.
+// `lamp_transmittance` bound (voxelize's), the fraction of the lamp each traced surface
+// sees past the fireballs and particles (shaders/common/fire.glsl), upsampled the same
+// way for composite's lamp_through_fire.
 //
 // Cone sets (tangent frame, z = normal; weights sum to 1):
 //   1   the normal.
@@ -147,14 +148,14 @@ public:
                     .doc = "voxel_mip.aniso: sample the directional chains"})
             .input({.name = "fixed_cones", .kind = TextureKind::Color3D, .required = false,
                     .doc = "voxel_mip.fixed_cones: trace the fixed cone set, one fetch per step (instead of aniso)"})
-            .input({.name = "fire", .kind = TextureKind::Color3D, .required = false,
-                    .doc = "voxelize.fire (fire_cover on): alpha = the lamp's transmittance through the "
-                           "fireballs (exact discs) and the particles (marched through it), for composite's "
-                           "lamp_through_fire (shaders/cone_trace/fire.glsl)"})
+            .input({.name = "lamp_transmittance", .kind = TextureKind::Color3D, .required = false,
+                    .doc = "voxelize.lamp_transmittance (fire_cover on): alpha = the fraction of the lamp each "
+                           "traced surface sees past the fire, upsampled for composite's lamp_through_fire "
+                           "(shaders/common/fire.glsl)"})
             .output({.name = "indirect", .format = Format::RGBA16F, .size = SizeRule::relativeOverParam("output_divisor"),
                      .doc = "rgb = indirect irradiance / π, a = AO (or with `lamp`: the lamp's projected solid "
-                            "angle; with `fire` bound: the lamp's transmittance through the fire); the output's "
-                            "size ÷ output_divisor"})
+                            "angle; with `lamp_transmittance` bound: the fraction of the lamp seen past the fire); "
+                            "the output's size ÷ output_divisor"})
             .internal({.name = "samples", .format = Format::RGBA16F, .size = traceGrid,
                        .doc = "trace_stride > 1: the traced samples"})
             .internal({.name = "planes", .format = Format::RGBA16F, .size = traceGrid,
@@ -198,7 +199,7 @@ public:
                              "alpha = the lamp's unshadowed projected solid angle at each traced surface (its "
                              "silhouette's contour, 16 vertices), upsampled with the indirect light, for composite's "
                              "lamp_model traced; off: alpha = ambient visibility"));
-        d.reads = kSceneCamera | kSceneLight | kSceneFireballs;  // the fireballs: with `fire` bound
+        d.reads = kSceneCamera | kSceneLight;
         return d;
     }
 
@@ -209,9 +210,9 @@ public:
             return ctx.fail("cones " + std::to_string(ctx.getInt("cones")) +
                             ": the fixed set traces 6 cones a pixel (4 on axis-aligned walls); set 6, or bind "
                             "`aniso` instead of `fixed_cones` for other counts");
-        if (ctx.getBool("lamp") && ctx.isBound("fire"))
-            return ctx.fail("`lamp` on and `fire` bound: both would fill the output's alpha; composite's lamp_model "
-                            "traced reads the one, lamp_through_fire the other");
+        if (ctx.getBool("lamp") && ctx.isBound("lamp_transmittance"))
+            return ctx.fail("`lamp` on and `lamp_transmittance` bound: both would fill the output's alpha; "
+                            "composite's lamp_model traced reads the one, lamp_through_fire the other");
         const kiln::TextureRef& voxels = ctx.input("voxels");
         kiln::Defines defines = schedule(ctx, voxels.width);
         defines.emplace_back("KILN_LAMP_IN_ALPHA", ctx.getBool("lamp") ? "1" : "0");
@@ -243,10 +244,8 @@ public:
         kiln::gl::bindTexture(trace, "u_voxels", voxels.id);
         kiln::gl::bindTexture(trace, "u_aniso", ctx.input("aniso").id);
         kiln::gl::bindTexture(trace, "u_fixedCones", ctx.input("fixed_cones").id);
-        kiln::gl::bindTexture(trace, "u_fire", ctx.input("fire").id);
+        kiln::gl::bindTexture(trace, "u_lampTransmittance", ctx.input("lamp_transmittance").id);
         auto loc = [&](const char* n) { return glGetUniformLocation(trace, n); };
-        glUniform1i(loc("u_firstFireball"), GLint(ctx.scene().firstInstance(kiln::kSceneFireballs)));
-        glUniform1i(loc("u_fireballCount"), GLint(ctx.scene().count(kiln::kSceneFireballs)));
         if (!ctx.isBound("fixed_cones")) {  // the fixed set is the shader's own
             const std::vector<float> cones = coneSet(ctx.getInt("cones"));
             glUniform1i(loc("u_coneCount"), GLint(cones.size() / 4));

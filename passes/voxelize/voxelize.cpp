@@ -42,10 +42,14 @@
 //      splat 1.4. Not the default: against the reference the floor next to the tumblers
 //      is worse (relMSE 0.0124 against the mesh's 0.0114 at 256², t = 0), though every
 //      region's mean light is closer (the floor's indirect light 0.966 -> 1.003×).
-//   The particles' cover on request (fire_cover on): a compute pass (voxelize/fire_cover.comp)
-//      shares each particle's cross-section among the voxels it overlaps, resolved into
-//      `fire` (the optical depth across each voxel, with mips) through which cone_trace
-//      marches the lamp's light: the fire rising round the dome hides part of it.
+//   The particles' cover on request (fire_cover on), first: a compute pass
+//      (voxelize/fire_cover.comp) shares each particle's cross-section among the voxels
+//      it overlaps, resolved into `fire` (the optical depth across each voxel, with mips);
+//      then `lamp_transmittance`, the fraction of the lamp seen past it and the fireballs
+//      on a grid half as fine (voxelize/fire_transmittance.comp, common/fire.glsl): the
+//      fire rising round the dome hides part of the lamp. The resolve takes the lamp's
+//      part of each voxel's light (summed apart from what it emits) through it;
+//      cone_trace takes the pixels' for composite.
 //   4. A compute pass (4³ groups) resolves sum/count into `radiance`: rgb = the mean
 //      outgoing radiance, a = occupancy (1 where any fragment landed, else 0). The
 //      colour is premultiplied by the occupancy (empty voxels are 0,0,0,0), which is
@@ -82,11 +86,17 @@ public:
                      .mips = kFullMipChain,
                      .doc = "fire_cover on: the fire particles' optical depth across each voxel (their "
                             "cross-sections per voxel face); mips: the mean",
+                     .producedWhen = {"fire_cover", {"on"}}})
+            .output({.name = "lamp_transmittance", .kind = TextureKind::Color3D, .format = Format::R16F,
+                     .size = SizeRule::fromParam("resolution", 0.5f),
+                     .doc = "fire_cover on: the fraction of the lamp each node of a grid half the voxels' "
+                            "resolution sees past the fireballs and particles (shaders/common/fire.glsl)",
                      .producedWhen = {"fire_cover", {"on"}}});
         d.internal({.name = "sums", .kind = TextureKind::Color3D, .format = Format::R32UI,
                     .size = SizeRule::fromParam("resolution", 1.0f, kSumChannels),
                     .doc = "the fixed-point accumulators (shaders/voxelize/sums.glsl): radiance rgb, fragment "
-                           "count, albedo rgb, normal xyz and the particles' cover, eleven grids side by side along x"});
+                           "count, albedo rgb, normal xyz, the particles' cover and (fire_cover on) the emitted part of the "
+                           "radiance apart, fourteen grids side by side along x"});
         d.internal({.name = "lamp_field", .format = Format::RG16F, .size = SizeRule::fixed(kLampFieldSide, kLampFieldSide),
                     .doc = "lamp_model field: the lamp's vector irradiance over (distance from its axis, height)"});
         d.param(intChoiceParam("resolution", 64, {32, 64, 128}, "voxels per side over [-1,1]^3"))
@@ -124,8 +134,9 @@ public:
                              "internal, built when the lamp changes; shaders/common/lamp_field.comp)"))
             .param(floatParam("shadow_bias", 0.002f, 0.0, 0.05, "depth bias of the (hard) shadow test"))
             .param(enumParam("fire_cover", "off", {"off", "on"},
-                             "on: `fire` holds how much light the fire's particles stop in each voxel, for "
-                             "cone_trace's `fire` (the lamp's light through the fire)"));
+                             "on: the lamp's light reaches the voxels through the fire (the fireballs and "
+                             "particles), and `lamp_transmittance` holds the fraction of it seen past the fire "
+                             "for cone_trace (composite's lamp_through_fire)"));
         d.reads = kSceneStatic | kSceneBodies | kSceneParticles | kSceneLight;
         return d;
     }
@@ -134,16 +145,18 @@ public:
         // 16 silhouette vertices (within 0.8 % of the exact irradiance; tests/gi/test_lamp.cpp)
         // or the old 32 quadrature points.
         const bool contour = ctx.getEnum("lamp_model") == "contour", field = ctx.getEnum("lamp_model") == "field";
+        const bool fireCover = ctx.getEnum("fire_cover") == "on";
         const kiln::Defines lamp = {{"KILN_LAMP_CONTOUR", contour ? "1" : "0"},
                                     {"KILN_LAMP_SAMPLES", contour || field ? "16" : "32"},
-                                    {"KILN_LAMP_FIELD", field ? "1" : "0"}};
+                                    {"KILN_LAMP_FIELD", field ? "1" : "0"},
+                                    {"KILN_FIRE_THROUGH", fireCover ? "1" : "0"}};
         GLuint raster = ctx.program({.stages = {"voxelize/voxelize.vert", "voxelize/voxelize.geom", "voxelize/voxelize.frag"},
                                      .defines = lamp});
-        const bool fireCover = ctx.getEnum("fire_cover") == "on";
-        GLuint resolve = ctx.program({.stages = {"voxelize/resolve.comp"},
-                                      .defines = {{"KILN_FIRE_COVER", fireCover ? "1" : "0"}}});
+        GLuint resolve = ctx.program({.stages = {"voxelize/resolve.comp"}, .defines = lamp});
         GLuint coverer = fireCover ? ctx.program({.stages = {"voxelize/fire_cover.comp"}}) : 0;
+        GLuint fireResolve = fireCover ? ctx.program({.stages = {"voxelize/fire_resolve.comp"}}) : 0;
         GLuint fireMip = fireCover ? ctx.program({.stages = {"voxelize/fire_mip.comp"}}) : 0;
+        GLuint fireLight = fireCover ? ctx.program({.stages = {"voxelize/fire_transmittance.comp"}}) : 0;
         const bool particles = ctx.getBool("particles");
         const bool splatParticles = particles && ctx.getEnum("particle_mode") == "splat";
         const bool splatFireballs = ctx.getEnum("fireball_mode") == "splat";
@@ -151,7 +164,7 @@ public:
         const bool splatTumblers = ctx.getEnum("tumbler_mode") == "splat";
         GLuint tumblerSplatter = splatTumblers ? ctx.program({.stages = {"voxelize/tumblers.comp"}, .defines = lamp}) : 0;
         if (!raster || !resolve || ((splatParticles || splatFireballs) && !splatter) ||
-            (splatTumblers && !tumblerSplatter) || (fireCover && (!coverer || !fireMip)))
+            (splatTumblers && !tumblerSplatter) || (fireCover && (!coverer || !fireResolve || !fireMip || !fireLight)))
             return;
         if (field && !buildLampField(ctx)) return;
         const kiln::TextureRef& out = ctx.output("radiance");
@@ -159,12 +172,12 @@ public:
 
         glClearTexImage(ctx.internal("sums").id, 0, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
 
+        // The particles' cover first: the surfaces' lamp light goes through it.
+        if (fireCover) coverFire(ctx, coverer, fireResolve, fireMip, fireLight, res);
         rasterize(ctx, raster, res, particles && !splatParticles, !splatFireballs, !splatTumblers);
         if (splatter && !splat(ctx, splatter, res, splatParticles, splatFireballs)) return;
         if (tumblerSplatter) splatTumblerShapes(ctx, tumblerSplatter, res);
-        if (coverer && !coverFire(ctx, coverer, res)) return;
-        resolveSums(ctx, resolve, out, res, fireCover);
-        if (fireCover) mipFire(ctx, fireMip);
+        resolveSums(ctx, resolve, out, res);
     }
 
 private:
@@ -237,19 +250,39 @@ private:
         return true;
     }
 
-    // fire_cover: the particles' cross-sections into the sums (cone_trace takes the
-    // fireballs exactly). False when the pass failed.
-    static bool coverFire(kiln::PassContext& ctx, GLuint coverer, int res) {
+    // fire_cover: the particles' cross-sections into the sums (common/fire.glsl takes the
+    // fireballs exactly), resolved into `fire` and its mips, ready for texture lookups.
+    static void coverFire(kiln::PassContext& ctx, GLuint coverer, GLuint resolver, GLuint mipper, GLuint lighter,
+                          int res) {
         const kiln::SceneView& scene = ctx.scene();
         const uint32_t count = scene.count(kiln::kSceneParticles);
-        if (count == 0) return true;
-        glUseProgram(coverer);
-        bindSums(ctx, coverer, GL_READ_WRITE);
-        glUniform1ui(glGetUniformLocation(coverer, "u_first"), scene.firstInstance(kiln::kSceneParticles));
-        glUniform1ui(glGetUniformLocation(coverer, "u_sphereCount"), count);
-        glUniform1i(glGetUniformLocation(coverer, "u_res"), res);
-        glDispatchCompute((count + 63) / 64, 1, 1);
-        return true;
+        if (count > 0) {
+            glUseProgram(coverer);
+            bindSums(ctx, coverer, GL_READ_WRITE);
+            glUniform1ui(glGetUniformLocation(coverer, "u_first"), scene.firstInstance(kiln::kSceneParticles));
+            glUniform1ui(glGetUniformLocation(coverer, "u_sphereCount"), count);
+            glUniform1i(glGetUniformLocation(coverer, "u_res"), res);
+            glDispatchCompute((count + 63) / 64, 1, 1);
+        }
+        const kiln::TextureRef& fire = ctx.output("fire");
+        glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+        glUseProgram(resolver);
+        bindSums(ctx, resolver, GL_READ_ONLY);
+        kiln::gl::bindImage(resolver, "u_fire", fire.id, 0, true, GL_WRITE_ONLY, GL_R16F);
+        const GLuint groups = GLuint((res + 3) / 4);
+        glDispatchCompute(groups, groups, groups);
+        mipFire(ctx, mipper);
+        // The lamp's transmittance on its grid, through the cover and the fireballs.
+        glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+        const kiln::TextureRef& light = ctx.output("lamp_transmittance");
+        glUseProgram(lighter);
+        kiln::gl::bindTexture(lighter, "u_fire", fire.id);
+        kiln::gl::bindImage(lighter, "u_transmittance", light.id, 0, true, GL_WRITE_ONLY, GL_R16F);
+        glUniform1i(glGetUniformLocation(lighter, "u_firstFireball"), GLint(scene.firstInstance(kiln::kSceneFireballs)));
+        glUniform1i(glGetUniformLocation(lighter, "u_fireballCount"), GLint(scene.count(kiln::kSceneFireballs)));
+        const GLuint lightGroups = GLuint((light.width + 3) / 4);
+        glDispatchCompute(lightGroups, lightGroups, lightGroups);
+        glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
     }
 
     // fire_cover: `fire`'s mips, each level the mean of the one below (voxelize/fire_mip.comp).
@@ -282,20 +315,20 @@ private:
     }
 
     // 4: the sums' averages into the outputs.
-    static void resolveSums(kiln::PassContext& ctx, GLuint resolve, const kiln::TextureRef& out, int res, bool fireCover) {
+    static void resolveSums(kiln::PassContext& ctx, GLuint resolve, const kiln::TextureRef& out, int res) {
         glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
         glUseProgram(resolve);
         bindSums(ctx, resolve, GL_READ_ONLY);
+        kiln::gl::bindTexture(resolve, "u_lampTransmittance", ctx.output("lamp_transmittance").id);  // fire_cover on
         kiln::gl::bindImage(resolve, "u_radiance", out.id, 0, true, GL_WRITE_ONLY, GL_RGBA16F);
         kiln::gl::bindImage(resolve, "u_albedo", ctx.output("albedo").id, 0, true, GL_WRITE_ONLY, GL_RGBA8);
         kiln::gl::bindImage(resolve, "u_normal", ctx.output("normal").id, 0, true, GL_WRITE_ONLY, GL_RGBA16F);
-        if (fireCover) kiln::gl::bindImage(resolve, "u_fire", ctx.output("fire").id, 0, true, GL_WRITE_ONLY, GL_R16F);
         const GLuint groups = GLuint((res + 3) / 4);
         glDispatchCompute(groups, groups, groups);
     }
 
     // The accumulators: one volume, kSumChannels grids along x (shaders/voxelize/sums.glsl).
-    static constexpr int kSumChannels = 11;
+    static constexpr int kSumChannels = 14;
     static void bindSums(kiln::PassContext& ctx, GLuint program, GLenum access) {
         kiln::gl::bindImage(program, "u_sums", ctx.internal("sums").id, 0, true, access, GL_R32UI);
     }

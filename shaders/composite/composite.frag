@@ -147,7 +147,7 @@ void main() {
 #endif
         float visible = max(irradiance.r, max(irradiance.g, irradiance.b)) > 0.0 ? lightVisibility(p + n * 0.004) : 0.0;
 #if KILN_LAMP_THROUGH_FIRE
-        visible *= texture(u_indirect, v_uv).a;  // through the fire (cone_trace/fire.glsl), upsampled
+        visible *= texture(u_indirect, v_uv).a;  // through the fire (common/fire.glsl), upsampled
 #endif
         vec3 direct = albedo / 3.14159265 * irradiance * visible;
 #if KILN_FIREBALLS_ANALYTIC

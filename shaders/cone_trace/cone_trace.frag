@@ -3,17 +3,15 @@
 // block: then pixel ij traces the G-buffer texel stride·ij + stride/2 (traceTexel in
 // upsample.glsl) and also writes that surface's plane for upsample.frag. Alpha: the
 // cone-traced ambient visibility, or (cone_trace.lamp) the lamp's projected solid angle,
-// or (`fire` bound) the lamp's transmittance through the fire.
+// or (`lamp_transmittance` bound) the fraction of the lamp seen past the fire.
 #include "common/frame.glsl"
 #include "trace.glsl"
-// One #if for both: an #include is spliced once per stage, even into a block the
-// preprocessor then drops, so a second #if including light.glsl again would get nothing.
-#if KILN_LAMP_IN_ALPHA || KILN_HAS_FIRE
-#include "common/shadow.glsl"  // and common/light.glsl
+#if KILN_LAMP_IN_ALPHA
+#include "common/light.glsl"
 #endif
-#if KILN_HAS_FIRE
-#include "common/instances.glsl"
-#include "fire.glsl"
+#if KILN_HAS_LAMP_TRANSMITTANCE
+// voxelize.lamp_transmittance: the fraction of the lamp seen past the fire (common/fire.glsl).
+layout(binding = 10) uniform sampler3D u_lampTransmittance;
 #endif
 #include "upsample.glsl"
 
@@ -89,8 +87,8 @@ void main() {
         // The lamp's unshadowed irradiance ÷ its radiance (smooth on a surface, like the
         // indirect light): traced here at one pixel in stride², upsampled with it.
         o_indirect.a = lampProjectedSolidAngle(p, n);
-#elif KILN_HAS_FIRE
-        o_indirect.a = fireTransmittance(p, n);  // the lamp's light through the fire (fire.glsl)
+#elif KILN_HAS_LAMP_TRANSMITTANCE
+        o_indirect.a = textureLod(u_lampTransmittance, p * 0.5 + 0.5, 0.0).r;  // upsampled for composite
 #endif
 #if KILN_REUSE
         o_age = vec4(0.0, p);

@@ -1,7 +1,7 @@
 #version 450 core
 // The particles' cover (voxelize's fire_cover on): how much of the light crossing each
-// voxel the fire's particles stop, for cone_trace to march the lamp's light through
-// (shaders/cone_trace/fire.glsl; the fireballs, few and large, it takes exactly). The
+// voxel the fire's particles stop, for common/fire.glsl to march the lamp's light
+// through (the fireballs, few and large, it takes exactly). The
 // particles are opaque spheres; seen as a medium, one of cross-section σ = π r² adds σ to
 // the integral of the extinction coefficient μ over the volume (μ = number density × σ).
 // Each particle's σ is shared among the voxels its bounding cube overlaps, in proportion
@@ -11,7 +11,7 @@
 // radius, a third of a 32³ voxel) lands in one to eight; what of its cube lies outside
 // the box is in no voxel (no ray inside the box crosses it).
 // One invocation per particle, instances [u_first, u_first + u_sphereCount), into the
-// fixed-point channel kFireCover of the sums (resolve.comp writes the output).
+// fixed-point channel kFireCover of the sums (fire_resolve.comp writes `fire`).
 #include "sums.glsl"
 
 layout(local_size_x = 64) in;

@@ -49,8 +49,8 @@ void main() {
                 if (gl_GlobalInvocationID.x < u_litCount) {
                     vec3 towards = 0.5 * (cubeLo + cubeHi) - centre;
                     vec3 n = dot(towards, towards) > 1e-12 ? normalize(towards) : vec3(0.0, 1.0, 0.0);
-                    uvec3 lit = toFixedRadiance(lampReflected(inst.albedo.rgb, centre + n * radius, n) + fireballEmission);
-                    addSurfaceToVoxel(ivec3(x, y, z), lit, inst.albedo.rgb, n);
+                    uvec3 lit = toFixedRadiance(lampReflected(inst.albedo.rgb, centre + n * radius, n));
+                    addSurfaceToVoxel(ivec3(x, y, z), lit, toFixedRadiance(fireballEmission), inst.albedo.rgb, n);
                 } else {
                     addToVoxel(ivec3(x, y, z), emitted);
                 }

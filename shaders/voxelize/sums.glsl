@@ -10,7 +10,7 @@
 // are signed: two's-complement adds wrap alike in a uint.
 layout(r32ui, binding = 0) uniform coherent uimage3D u_sums;
 const int kSumR = 0, kSumG = 1, kSumB = 2, kCount = 3, kAlbedoR = 4, kAlbedoG = 5, kAlbedoB = 6, kNormalX = 7,
-          kNormalY = 8, kNormalZ = 9, kFireCover = 10;
+          kNormalY = 8, kNormalZ = 9, kFireCover = 10, kEmitR = 11, kEmitG = 12, kEmitB = 13;
 
 // Voxel v's texel of one channel (the grid's side: the volume's height).
 ivec3 sumTexel(ivec3 v, int channel) { return ivec3(v.x + channel * imageSize(u_sums).y, v.yz); }
@@ -24,17 +24,35 @@ const float kCoverScale = 4096.0;  // the fire's optical depth across a voxel: u
 
 uvec3 toFixedRadiance(vec3 radiance) { return uvec3(clamp(radiance, 0.0, kMaxRadiance) * kFixedScale + 0.5); }
 
-// One fragment's radiance (toFixedRadiance) added to voxel v.
-void addToVoxel(ivec3 v, uvec3 fixedRgb) {
-    addToSum(v, kSumR, fixedRgb.r);
-    addToSum(v, kSumG, fixedRgb.g);
-    addToSum(v, kSumB, fixedRgb.b);
+// With KILN_FIRE_THROUGH (voxelize's fire_cover on) a fragment's lamp light (kSumR/G/B)
+// and its emission (kEmitR/G/B) are summed apart: resolve.comp takes the lamp's part
+// through the fire; without it, both into kSumR/G/B.
+
+// One emitting fragment with no surface (a particle), radiance from toFixedRadiance.
+void addToVoxel(ivec3 v, uvec3 emitted) {
+#if KILN_FIRE_THROUGH
+    addToSum(v, kEmitR, emitted.r);
+    addToSum(v, kEmitG, emitted.g);
+    addToSum(v, kEmitB, emitted.b);
+#else
+    addToSum(v, kSumR, emitted.r);
+    addToSum(v, kSumG, emitted.g);
+    addToSum(v, kSumB, emitted.b);
+#endif
     addToSum(v, kCount, 1u);
 }
 
-// A surface fragment: its radiance, and its albedo and unit normal.
-void addSurfaceToVoxel(ivec3 v, uvec3 fixedRgb, vec3 albedo, vec3 n) {
-    addToVoxel(v, fixedRgb);
+// A surface fragment: the lamp light it reflects and what it emits, its albedo and unit
+// normal.
+void addSurfaceToVoxel(ivec3 v, uvec3 lit, uvec3 emitted, vec3 albedo, vec3 n) {
+#if KILN_FIRE_THROUGH
+    addToSum(v, kSumR, lit.r);
+    addToSum(v, kSumG, lit.g);
+    addToSum(v, kSumB, lit.b);
+    addToVoxel(v, emitted);
+#else
+    addToVoxel(v, lit + emitted);
+#endif
     uvec3 a = uvec3(clamp(albedo, 0.0, 1.0) * kUnitScale + 0.5);
     ivec3 d = ivec3(round(clamp(n, -1.0, 1.0) * kUnitScale));
     addToSum(v, kAlbedoR, a.r);

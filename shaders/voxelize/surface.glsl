@@ -3,7 +3,8 @@
 // (common/light.glsl) with one hard shadow-map test, taken one voxel off the surface
 // along its normal (against acne). Emission is the caller's to add.
 // Needs common/light.glsl and common/shadow.glsl; binds the shadow map at texture unit 0
-// and, with KILN_LAMP_FIELD, the lamp's field (common/lamp_field.comp) at unit 1.
+// and, with KILN_LAMP_FIELD, the lamp's field (common/lamp_field.comp) at unit 1. The
+// fire between a surface and the lamp is resolve.comp's to take (KILN_FIRE_THROUGH).
 layout(binding = 0) uniform sampler2D u_shadowMap;
 #if KILN_LAMP_FIELD
 #include "common/lamp_field.glsl"

@@ -39,8 +39,8 @@ void main() {
     vec3 n = normalize(v_normal);
     float scale = u_emissionScale;
     if (u_sphereFlux) scale *= sphereFluxScale(kilnSphereRadius(inst));
-    vec3 radiance = lampReflected(albedo, v_world, n) + inst.emissive.rgb * scale;
-    uvec3 fixedRgb = toFixedRadiance(radiance);
+    uvec3 lit = toFixedRadiance(lampReflected(albedo, v_world, n));
+    uvec3 emitted = toFixedRadiance(inst.emissive.rgb * scale);
 
     float zLo = clamp(depth - span, v_depthRange.x, v_depthRange.y);
     float zHi = clamp(depth + span, v_depthRange.x, v_depthRange.y);
@@ -49,7 +49,7 @@ void main() {
     ivec2 ij = clamp(ivec2(px), ivec2(0), ivec2(u_res - 1));
     for (int k = k0; k <= min(k1, k0 + 2); ++k) {
         // Back from (2D, depth) to (x, y, z): the inverse of the geometry shader's swizzle.
-        addSurfaceToVoxel(v_axis == 0 ? ivec3(k, ij.x, ij.y) : v_axis == 1 ? ivec3(ij.y, k, ij.x) : ivec3(ij, k), fixedRgb,
-                          albedo, n);
+        addSurfaceToVoxel(v_axis == 0 ? ivec3(k, ij.x, ij.y) : v_axis == 1 ? ivec3(ij.y, k, ij.x) : ivec3(ij, k), lit,
+                          emitted, albedo, n);
     }
 }

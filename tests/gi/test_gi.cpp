@@ -520,7 +520,7 @@ TEST_CASE("cone_trace fire: a fireball under the lamp hides about the part of it
     // One still fireball (r 0.1) on the lamp's axis at y = 0.2, an empty box, lit only by
     // the lamp (composite's indirect_strength 0, no shadow map: the fire is the only
     // thing between the floor and the lamp; paused: no particles). cone_trace traces
-    // every pixel; its alpha is the transmittance T (shaders/cone_trace/fire.glsl, the
+    // every pixel; its alpha is the transmittance T (shaders/common/fire.glsl, the
     // fireballs as discs). Against a quadrature of the lamp's area form whose segments
     // meet the sphere or not (above).
     const glm::dvec3 centre(0.0, 0.2, 0.0);
@@ -537,7 +537,7 @@ TEST_CASE("cone_trace fire: a fireball under the lamp hides about the part of it
             {"id": "voxel_mip", "module": "voxel_mip", "inputs": {"radiance": "voxelize.radiance"}},
             {"id": "cone_trace", "module": "cone_trace",
              "inputs": {"normal": "gbuffer.normal", "depth": "gbuffer.depth", "voxels": "voxel_mip.iso",
-                        "fire": "voxelize.fire"}},
+                        "lamp_transmittance": "voxelize.lamp_transmittance"}},
             {"id": "composite", "module": "composite",
              "inputs": {"albedo": "gbuffer.albedo", "normal": "gbuffer.normal", "depth": "gbuffer.depth",
                         "indirect": "cone_trace.indirect"},
@@ -591,6 +591,63 @@ TEST_CASE("cone_trace fire: a fireball under the lamp hides about the part of it
         // composite multiplies the lamp's light by it (half floats: 0.5 %).
         CHECK(shaded.at(pr.x, pr.y)[0] == Approx(lit.at(pr.x, pr.y)[0] * transmittance).epsilon(0.005));
     }
+}
+
+TEST_CASE("voxelize fire_cover: the voxels' lamp light goes through the fire, their emission does not",
+          "[gi][voxelize][fire]") {
+    // The same still fireball (r 0.1) under the lamp, the box empty: voxelized with
+    // fire_cover off, then on. On, resolve.comp multiplies the lamp's part of each voxel's
+    // light by lamp_transmittance (read back here and interpolated as the shader does:
+    // at the voxel's centre) and adds the emitted part untouched.
+    Rig rig(writeScene("fireball_under_lamp.json",
+                       R"({"tumblers": [], "marbles": [],
+                           "fireballs": [{"position": [0.0, 0.2, 0.0], "velocity": [0, 0, 0], "radius": 0.1,
+                                          "color": [1.0, 0.5, 0.1]}]})"),
+            64);
+    auto voxelized = [&](const char* cover) {
+        rig.load(pipeline("voxel_view.color", std::string(R"(
+            {"id": "shadow", "module": "shadow", "params": {"size": 256}},
+            {"id": "voxelize", "module": "voxelize", "inputs": {"shadow_map": "shadow.depth"},
+             "params": {"resolution": 32, "fire_cover": ")") + cover + R"("}},
+            {"id": "voxel_view", "module": "voxel_view", "inputs": {"voxels": "voxelize.radiance"}})"),
+                 {"voxelize.lamp_transmittance"});
+        rig.app.frame();
+        rig.checkNoErrors();
+        return read3d(rig.tex("voxelize", "radiance"), 0);
+    };
+    const Volume off = voxelized("off"), on = voxelized("on");
+    const Volume grid = read3d(rig.tex("voxelize", "lamp_transmittance"), 0);
+    REQUIRE(grid.n == 16);
+    // Trilinear, clamped to the edge, at a voxel's centre: what textureLod returns.
+    auto transmittance = [&](glm::ivec3 v) {
+        const glm::vec3 g = (glm::vec3(v) + 0.5f) * 0.5f - 0.5f;  // in grid texels, centres at integers
+        const glm::ivec3 lo = glm::ivec3(glm::floor(g));
+        const glm::vec3 f = g - glm::vec3(lo);
+        float t = 0.0f;
+        for (int k = 0; k < 8; ++k) {
+            const glm::ivec3 o(k & 1, (k >> 1) & 1, k >> 2);
+            const glm::ivec3 c = glm::clamp(lo + o, 0, grid.n - 1);
+            const float w = (o.x ? f.x : 1 - f.x) * (o.y ? f.y : 1 - f.y) * (o.z ? f.z : 1 - f.z);
+            t += w * grid.at(c.x, c.y, c.z)[0];
+        }
+        return t;
+    };
+    // The floor's top voxel layer (y index 0) under the fireball and far from it: all lamp
+    // light, no emission. Half floats: 1 %.
+    const glm::ivec3 under = voxelOf({0.0f, -0.99f, 0.0f}, 32), far = voxelOf({-0.8f, -0.99f, 0.7f}, 32);
+    for (const glm::ivec3& v : {under, far}) {
+        const float t = transmittance(v), lit = off.at(v.x, v.y, v.z)[1], seen = on.at(v.x, v.y, v.z)[1];
+        INFO("floor voxel " << v.x << ", " << v.z << ": lamp light " << lit << " -> " << seen << ", transmittance " << t);
+        REQUIRE(lit > 0.0f);
+        CHECK(seen == Approx(lit * t).epsilon(0.01));
+        if (v == under) CHECK(t < 0.85f);  // the fireball hides about a quarter of the lamp from there
+        else CHECK(t > 0.999f);
+    }
+    // The fireball's own voxel: its emission (green 0.5 × 6 = 3) stays, whatever the
+    // fire hides of the lamp's light on it (on its surface, under 0.3).
+    const glm::ivec3 ball = voxelOf({0.0f, 0.2f, 0.0f}, 32);
+    CHECK(on.at(ball.x, ball.y, ball.z)[1] > 0.9f * off.at(ball.x, ball.y, ball.z)[1]);
+    CHECK(on.at(ball.x, ball.y, ball.z)[1] > 2.5f);
 }
 
 TEST_CASE("gbuffer: particles drawn as points cover what their meshes cover, where the simulation has them",

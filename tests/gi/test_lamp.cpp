@@ -336,7 +336,7 @@ TEST_CASE("lamp: traced at one pixel in 4×4 and upsampled, the lamp's light sta
         for (auto& pass : p["passes"]) {
             // The lamp in cone_trace's alpha, where the default keeps its transmittance
             // through the fire: without it here, so both models light alike.
-            if (pass["id"] == "cone_trace") pass["params"]["lamp"] = true, pass["inputs"].erase("fire");
+            if (pass["id"] == "cone_trace") pass["params"]["lamp"] = true, pass["inputs"].erase("lamp_transmittance");
             if (pass["id"] == "composite") {
                 pass["params"]["lamp_through_fire"] = false;
                 pass["params"]["lamp_model"] = model;

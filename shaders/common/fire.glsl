@@ -1,8 +1,10 @@
-// The lamp's light through the fire (cone_trace's `fire` bound: voxelize's fire_cover):
-// the fraction of the lamp a surface point sees past the fireballs and their particles,
-// which the shadow map (drawn without them, from one point of the lamp) cannot hide it
-// by. Smooth over a surface as the indirect light is, so traced at cone_trace's samples
-// and upsampled with it, in alpha. For the particles' cone the lamp, as p sees it, is a
+// The lamp's light through the fire (voxelize's fire_cover on): the fraction of the lamp
+// a point sees past the fireballs and their particles, which the shadow map (drawn
+// without them, from one point of the lamp) cannot hide it by. The lamp is large, so
+// it changes slowly away from the fire: voxelize evaluates it on a grid half its
+// voxels' resolution (voxelize/fire_transmittance.comp, `lamp_transmittance`), which
+// the voxels' lamp light (voxelize/resolve.comp) and cone_trace's traced pixels (alpha,
+// for composite's lamp_through_fire) look up. For the particles' cone the lamp, as p sees it, is a
 // disc of its apparent area: |d.y| of its rim's disc (from below) plus the rest of the
 // circular segment it shows from the side, round the direction d to the shadow map's
 // eye (the centroid of its cap; common/shadow.glsl).
