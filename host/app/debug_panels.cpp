@@ -140,7 +140,8 @@ void pipelineSwitcher(WindowState& state, float width) {
     App& app = *state.app;
     const std::string current = fs::path(app.runtime().pipelineFile()).filename().string();
     ImGui::SetNextItemWidth(width);
-    if (ImGui::BeginCombo("##pipeline", current.c_str())) {
+    // As tall as the list (up to the window): a ninth file fell below the default eight rows.
+    if (ImGui::BeginCombo("##pipeline", current.c_str(), ImGuiComboFlags_HeightLargest)) {
         if (ImGui::IsWindowAppearing()) listPipelines(state);
         for (const std::string& p : state.pipelines) {
             const std::string name = fs::path(p).filename().string();
