@@ -204,25 +204,46 @@ TEST_CASE("voxelize: a tumbler's shell is closed — no 6-connected path from th
 }
 
 namespace {
-// ∫ over the shipped lamp's cap (sphere (0, 1.1, 0), r 0.35, below y = 1) of
-// cos θ_q / d² dA seen from p: the irradiance per unit radiance with cos θ_p ≤ 1.
-// Midpoint rule on 400 × 400 cells of (height, angle) — equal-area cells.
-double lampIrradianceBound(glm::dvec3 p) {
+// The midpoint rule over the shipped lamp's cap (sphere (0, 1.1, 0), r 0.35, below
+// y = 1) on n × n equal-area cells of (height, angle): Σ term(q, outward normal) · dA.
+template <class Term>
+double overLampCap(int n, Term term) {
     const glm::dvec3 c(0.0, 1.1, 0.0);
     const double r = 0.35, yLow = c.y - r, yHigh = 1.0;
-    const int n = 400;
-    const double cellArea = 2.0 * M_PI * r * (yHigh - yLow) / (n * n);
+    const double cellArea = 2.0 * M_PI * r * (yHigh - yLow) / (double(n) * n);
     double sum = 0.0;
     for (int i = 0; i < n; ++i)
         for (int j = 0; j < n; ++j) {
             const double h = yLow + (i + 0.5) * (yHigh - yLow) / n - c.y, phi = (j + 0.5) * 2.0 * M_PI / n;
             const double ring = std::sqrt(r * r - h * h);
             const glm::dvec3 q = c + glm::dvec3(ring * std::cos(phi), h, ring * std::sin(phi));
-            const glm::dvec3 w = q - p;
-            const double d2 = glm::dot(w, w);
-            sum += std::max(0.0, -glm::dot((q - c) / r, w) / std::sqrt(d2)) / d2 * cellArea;
+            sum += term(q, (q - c) / r) * cellArea;
         }
     return sum;
+}
+
+// ∫_cap cos θ_q / d² dA seen from p: the irradiance per unit radiance with cos θ_p ≤ 1.
+double lampIrradianceBound(glm::dvec3 p) {
+    return overLampCap(400, [&](glm::dvec3 q, glm::dvec3 nq) {
+        const glm::dvec3 w = q - p;
+        const double d2 = glm::dot(w, w);
+        return std::max(0.0, -glm::dot(nq, w) / std::sqrt(d2)) / d2;
+    });
+}
+
+// The lamp's irradiance ÷ its radiance at p (normal n), the area form, counting only the
+// cap's points whose segment to p misses the sphere (centre, radius): the fraction a
+// sphere hides, computed without voxels or cones.
+double lampIrradianceMissing(glm::dvec3 p, glm::dvec3 n, glm::dvec3 centre, double radius) {
+    return overLampCap(600, [&](glm::dvec3 q, glm::dvec3 nq) {
+        const glm::dvec3 w = q - p;
+        const double d2 = glm::dot(w, w), d = std::sqrt(d2);
+        const double cosP = glm::dot(n, w) / d, cosQ = -glm::dot(nq, w) / d;
+        if (cosP <= 0.0 || cosQ <= 0.0) return 0.0;
+        // The segment p → q against the sphere: its nearest point to the centre.
+        const double s = std::clamp(glm::dot(centre - p, w) / d2, 0.0, 1.0);
+        return glm::distance(p + s * w, centre) < radius ? 0.0 : cosP * cosQ / d2;
+    });
 }
 }  // namespace
 
@@ -495,33 +516,6 @@ TEST_CASE("voxelize fire_cover: every particle's whole cross-section lands in th
         bare += vol.at(v.x, v.y, v.z)[0] <= 0.0f;
     }
     CHECK(bare == 0);
-}
-
-// The lamp's irradiance ÷ its radiance at p (normal n), the area form over the
-// emitter (the lamp's ball below the ceiling) on a fine grid, counting only the
-// points whose segment to p misses the sphere (centre, radius): the fraction a
-// sphere hides, computed without voxels or cones.
-double lampIrradianceMissing(glm::dvec3 p, glm::dvec3 n, glm::dvec3 centre, double radius) {
-    const glm::dvec3 c(0.0, 1.1, 0.0);
-    const double r = 0.35, yLow = c.y - r, yHigh = 1.0;
-    const int steps = 600;
-    const double cellArea = 2.0 * M_PI * r * (yHigh - yLow) / (steps * steps);
-    double sum = 0.0;
-    for (int i = 0; i < steps; ++i)
-        for (int j = 0; j < steps; ++j) {
-            const double h = yLow + (i + 0.5) * (yHigh - yLow) / steps - c.y, phi = (j + 0.5) * 2.0 * M_PI / steps;
-            const double ring = std::sqrt(r * r - h * h);
-            const glm::dvec3 q = c + glm::dvec3(ring * std::cos(phi), h, ring * std::sin(phi));
-            const glm::dvec3 w = q - p;
-            const double d2 = glm::dot(w, w), d = std::sqrt(d2);
-            const double cosP = glm::dot(n, w) / d, cosQ = -glm::dot((q - c) / r, w) / d;
-            if (cosP <= 0.0 || cosQ <= 0.0) continue;
-            // The segment p → q against the sphere: its nearest point to the centre.
-            const double s = std::clamp(glm::dot(centre - p, w) / d2, 0.0, 1.0);
-            if (glm::distance(p + s * w, centre) < radius) continue;
-            sum += cosP * cosQ / d2 * cellArea;
-        }
-    return sum;
 }
 
 TEST_CASE("cone_trace fire: a fireball under the lamp hides about the part of it its disc covers, and composite "
