@@ -251,7 +251,8 @@ private:
     }
 
     // fire_cover: the particles' cross-sections into the sums (common/fire.glsl takes the
-    // fireballs exactly), resolved into `fire` and its mips, ready for texture lookups.
+    // fireballs exactly), resolved into `fire` and its mips; then from them and the
+    // fireballs `lamp_transmittance`, ready for the resolve's and cone_trace's lookups.
     static void coverFire(kiln::PassContext& ctx, GLuint coverer, GLuint resolver, GLuint mipper, GLuint lighter,
                           int res) {
         const kiln::SceneView& scene = ctx.scene();

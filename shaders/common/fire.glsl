@@ -4,10 +4,11 @@
 // it changes slowly away from the fire: voxelize evaluates it on a grid half its
 // voxels' resolution (voxelize/fire_transmittance.comp, `lamp_transmittance`), which
 // the voxels' lamp light (voxelize/resolve.comp) and cone_trace's traced pixels (alpha,
-// for composite's lamp_through_fire) look up. For the particles' cone the lamp, as p sees it, is a
-// disc of its apparent area: |d.y| of its rim's disc (from below) plus the rest of the
-// circular segment it shows from the side, round the direction d to the shadow map's
-// eye (the centroid of its cap; common/shadow.glsl).
+// for composite's lamp_through_fire) look up. For the particles' cone the lamp, as p
+// sees it, is a disc of its apparent area: |d.y| of its rim's disc (from below) plus the
+// rest of the circular segment it shows from the side, round the direction d to the
+// shadow map's eye (the centroid of its cap; common/shadow.glsl). Needs
+// common/shadow.glsl and common/instances.glsl.
 //   fireballs  each a disc of angular radius asin(r / distance) against 16 cells of the
 //              lamp's cap (each a disc of its projected solid angle, weighted by its
 //              share of the irradiance): the part of each cell it overlaps is hidden.
@@ -63,11 +64,9 @@ float fireTransmittance(vec3 p, vec3 n) {
     // angle: what each fireball's disc overlaps of each cell's is hidden. The cells give
     // the lamp its shape (a squat dome seen from the side is short, not a disc). The
     // first 64 fireballs (kiln-bench-skip's busiest scene has 50; beyond, the rest hide
-    // nothing).
-
-    // Only fireballs whose disc meets the lamp's ball's (a bound on the cap's) take part;
-    // none: nothing to do. (Loops whose count is 0 for every lane cost nothing on llvmpipe,
-    // where an `if` body runs for every lane.)
+    // nothing). Only those whose disc meets the lamp's ball's (a bound on the cap's) take
+    // part; none: nothing to do (loops whose count is 0 for every lane cost nothing on
+    // llvmpipe, where an `if` body runs for every lane).
     float lampBound = asin(min(radius / max(length(toCentre), 1e-6), 1.0));
     vec3 towardsBall = toCentre / max(length(toCentre), 1e-6);
     uvec2 inFront = uvec2(0u);  // bit i of word i / 32: fireball i may hide part of the lamp

@@ -112,6 +112,13 @@
 //   units stop at 8). The host logs a program that goes past them as a portability
 //   warning at the declaration's file:line (Runtime::portabilityWarnings()).
 //
+// INCLUDES
+//   `#include "name"` is spliced into the stage once, where it first appears, before
+//   GLSL's preprocessor runs: an include inside an `#if` the preprocessor then drops
+//   still counts, and a later include of the same file brings nothing (its names come
+//   out undeclared). Include a shared file outside `#if`, or under the same condition
+//   everywhere it is included.
+//
 // DERIVATIVES
 //   Take dFdx/dFdy/fwidth, and texture() lookups that pick their mip level from them,
 //   before a fragment shader's first `discard`: after it they are undefined. llvmpipe
