@@ -41,6 +41,7 @@ private:
     uint64_t generation_ = 0;
     // What the renderer last got.
     uint64_t sentGeneration_ = 0, sentBodies_ = ~0ull, sentParticles_ = ~0ull;
+    uint64_t sentFireballs_ = ~0ull;  // the bodies version the particles were culled against
     int sentHighlight_ = -2;
 };
 

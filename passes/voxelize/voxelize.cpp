@@ -263,8 +263,6 @@ private:
             glUniform1ui(glGetUniformLocation(coverer, "u_first"), scene.firstInstance(kiln::kSceneParticles));
             glUniform1ui(glGetUniformLocation(coverer, "u_sphereCount"), count);
             glUniform1i(glGetUniformLocation(coverer, "u_res"), res);
-            glUniform1i(glGetUniformLocation(coverer, "u_firstFireball"), GLint(scene.firstInstance(kiln::kSceneFireballs)));
-            glUniform1i(glGetUniformLocation(coverer, "u_fireballCount"), GLint(scene.count(kiln::kSceneFireballs)));
             glDispatchCompute((count + 63) / 64, 1, 1);
         }
         const kiln::TextureRef& fire = ctx.output("fire");

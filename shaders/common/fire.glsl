@@ -8,7 +8,7 @@
 // sees it, is a disc of its apparent area: |d.y| of its rim's disc (from below) plus the
 // rest of the circular segment it shows from the side, round the direction d to the
 // shadow map's eye (the centroid of its cap; common/shadow.glsl). Needs
-// common/shadow.glsl and common/instances.glsl.
+// common/shadow.glsl.
 //   fireballs  each a disc of angular radius asin(r / distance) against 16 cells of the
 //              lamp's cap (each a disc of its projected solid angle, weighted by its
 //              share of the irradiance): the part of each cell it overlaps is hidden.
@@ -22,7 +22,13 @@
 //              the particles as a random medium. Steps half the cone's diameter apart.
 // The fractions each let through multiply (the spheres lie independently).
 layout(binding = 10) uniform sampler3D u_fire;
-uniform int u_firstFireball, u_fireballCount;
+
+// The fireballs that may stand between p and the lamp, and fireball i of them (xyz its
+// centre, w its radius; at most kFireMaxFireballs). The includer defines them
+// (voxelize/fire_transmittance.comp: a list per workgroup in shared memory; every
+// fireball read from the instance buffer in every loop cost 14 ms at 50 fireballs).
+int fireballCount();
+vec4 fireballSphere(int i);
 
 const int kFireMaxSteps = 48;
 const int kFireLampCells = 16;
@@ -67,48 +73,71 @@ float fireTransmittance(vec3 p, vec3 n) {
     // nothing). Only those whose disc meets the lamp's ball's (a bound on the cap's) take
     // part; none: nothing to do (loops whose count is 0 for every lane cost nothing on
     // llvmpipe, where an `if` body runs for every lane).
-    float lampBound = asin(min(radius / max(length(toCentre), 1e-6), 1.0));
-    vec3 towardsBall = toCentre / max(length(toCentre), 1e-6);
+    // The test, without inverse trigonometry: the angle between the directions to the
+    // ball and the fireball below the sum of their angular radii, cos(apart) > cos(α + β).
+    float toLampBall = max(length(toCentre), 1e-6);
+    float sinLamp = min(radius / toLampBall, 1.0), cosLamp = sqrt(1.0 - sinLamp * sinLamp);
+    vec3 towardsBall = toCentre / toLampBall;
     uvec2 inFront = uvec2(0u);  // bit i of word i / 32: fireball i may hide part of the lamp
-    for (int i = 0; i < min(u_fireballCount, kFireMaxFireballs); ++i) {
-        KilnInstance f = kiln_instances[u_firstFireball + i];
-        vec3 toBall = kilnSphereCentre(f) - origin;
-        float b = length(toBall), r = kilnSphereRadius(f);
-        float apart = acos(clamp(dot(toBall / max(b, 1e-6), towardsBall), -1.0, 1.0));
-        if (apart < lampBound + asin(min(r / max(b, 1e-6), 1.0)) && b < end + r) inFront[i >> 5] |= 1u << (i & 31);
+    for (int i = 0; i < min(fireballCount(), kFireMaxFireballs); ++i) {
+        vec4 ball = fireballSphere(i);
+        vec3 toBall = ball.xyz - origin;
+        float b = max(length(toBall), 1e-6), r = ball.w;
+        float sinBall = min(r / b, 1.0), cosBall = sqrt(1.0 - sinBall * sinBall);
+        float cosSum = cosLamp * cosBall - sinLamp * sinBall;  // cos(α + β); α + β ≥ π/2 when the ball holds p
+        bool meets = sinBall >= 1.0 || dot(toBall / b, towardsBall) > cosSum;
+        if (meets && b < end + r) inFront[i >> 5] |= 1u << (i & 31);
     }
     float through = 1.0;
     for (int pass = 0; pass < (any(notEqual(inFront, uvec2(0u))) ? 1 : 0); ++pass) {
+        // The cells: direction, angular radius, distance and weight; then each fireball in
+        // front against every cell, its own direction and angle found once.
         const float yLow = u_lightPos.y - radius, yHigh = min(kCeilingY, u_lightPos.y + radius);
         const float dy = (yHigh - yLow) / float(kFireLampCells);
         const float cellArea = 6.28318531 * radius * (yHigh - yLow) / float(kFireLampCells);
         const vec2 turn = vec2(cos(2.39996323), sin(2.39996323));
         vec2 around = vec2(1.0, 0.0);
-        float seen = 0.0, hidden = 0.0;
+        vec3 cellDir[kFireLampCells];
+        float cellAngle[kFireLampCells], cellDistance[kFireLampCells], weight[kFireLampCells],
+            covered[kFireLampCells];  // the fraction of each the fireballs hide (at most all of it)
+        float seen = 0.0;
         for (int c = 0; c < kFireLampCells; ++c) {
             float h = yLow + (float(c) + 0.5) * dy - u_lightPos.y;
             float ring = sqrt(max(radius * radius - h * h, 0.0));
             vec3 nq = vec3(around.x * ring, h, around.y * ring) / radius;
             around = vec2(around.x * turn.x - around.y * turn.y, around.x * turn.y + around.y * turn.x);
             vec3 w = u_lightPos.xyz + nq * radius - origin;
-            float d2 = dot(w, w), d = sqrt(d2);
-            vec3 toCell = w / d;
-            float cosP = max(dot(n, toCell), 0.0), cosQ = max(-dot(nq, toCell), 0.0);
-            float weight = cosP * cosQ / d2;
-            float cellAngle = max(sqrt(cosQ * cellArea / (3.14159265 * d2)), 1e-6);
-            float covered = 0.0;  // the cell's fraction the fireballs hide (at most all of it)
-            for (int word = 0; word < 2; ++word)
-            for (uint left = inFront[word]; left != 0u; left &= left - 1u) {
-                KilnInstance f = kiln_instances[u_firstFireball + 32 * word + findLSB(left)];
-                vec3 toBall = kilnSphereCentre(f) - origin;
-                float b = length(toBall), r = kilnSphereRadius(f);
-                float ballAngle = asin(min(r / max(b, 1e-6), 1.0));
-                float apart = acos(clamp(dot(toBall / max(b, 1e-6), toCell), -1.0, 1.0));
-                covered += b < d + r ? discOverlap(cellAngle, ballAngle, apart) / (3.14159265 * cellAngle * cellAngle) : 0.0;
-            }
-            seen += weight;
-            hidden += weight * min(covered, 1.0);
+            float d2 = dot(w, w);
+            cellDistance[c] = sqrt(d2);
+            cellDir[c] = w / cellDistance[c];
+            float cosP = max(dot(n, cellDir[c]), 0.0), cosQ = max(-dot(nq, cellDir[c]), 0.0);
+            weight[c] = cosP * cosQ / d2;
+            cellAngle[c] = max(sqrt(cosQ * cellArea / (3.14159265 * d2)), 1e-6);
+            covered[c] = 0.0;
+            seen += weight[c];
         }
+        for (int word = 0; word < 2; ++word)
+            for (uint left = inFront[word]; left != 0u; left &= left - 1u) {
+                vec4 ball = fireballSphere(32 * word + findLSB(left));
+                vec3 toBall = ball.xyz - origin;
+                float b = max(length(toBall), 1e-6), r = ball.w;
+                float sinBall = min(r / b, 1.0), cosBall = sqrt(1.0 - sinBall * sinBall);
+                float ballAngle = asin(sinBall);
+                vec3 ballDir = toBall / b;
+                for (int c = 0; c < kFireLampCells; ++c) {
+                    // Apart by more than the two radii (cos below cos(α + β)), or behind the
+                    // cell: nothing hidden, and no inverse cosines (a loop, for llvmpipe).
+                    float cosine = dot(ballDir, cellDir[c]);
+                    float sinCell = min(cellAngle[c], 1.0), cosCell = sqrt(1.0 - sinCell * sinCell);
+                    bool meets = (sinBall >= 1.0 || cosine > cosCell * cosBall - sinCell * sinBall) &&
+                                 b < cellDistance[c] + r;
+                    for (int k = meets ? 1 : 0; k > 0; --k)
+                        covered[c] += discOverlap(cellAngle[c], ballAngle, acos(clamp(cosine, -1.0, 1.0))) /
+                                      (3.14159265 * cellAngle[c] * cellAngle[c]);
+                }
+            }
+        float hidden = 0.0;
+        for (int c = 0; c < kFireLampCells; ++c) hidden += weight[c] * min(covered[c], 1.0);
         through = seen > 0.0 ? 1.0 - hidden / seen : 1.0;
     }
 

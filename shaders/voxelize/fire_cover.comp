@@ -9,8 +9,8 @@
 // μ·h, the optical depth across one voxel of side h: a voxel holding one sphere whose
 // disc covers a fraction f of a face has μ·h = f. A particle (0.35 of its fireball's
 // radius, a third of a 32³ voxel) lands in one to eight; what of its cube lies outside
-// the box is in no voxel (no ray inside the box crosses it), and one inside a fireball
-// none.
+// the box is in no voxel (no ray inside the box crosses it). Particles wholly inside a
+// fireball are not in the scene's instances (host/scene/live_scene.cpp).
 // One invocation per particle, instances [u_first, u_first + u_sphereCount), into the
 // fixed-point channel kFireCover of the sums (fire_resolve.comp writes `fire`).
 #include "sums.glsl"
@@ -22,19 +22,12 @@ layout(local_size_x = 64) in;
 uniform uint u_first;
 uniform uint u_sphereCount;
 uniform int u_res;  // voxels per side
-uniform int u_firstFireball, u_fireballCount;
 
 void main() {
     if (gl_GlobalInvocationID.x >= u_sphereCount) return;
     KilnInstance inst = kiln_instances[u_first + gl_GlobalInvocationID.x];
     vec3 centre = kilnSphereCentre(inst);
     float radius = kilnSphereRadius(inst);
-    // Inside a fireball (they are born within its radius) a particle hides nothing the
-    // fireball does not: common/fire.glsl takes the fireball's own disc.
-    for (int i = 0; i < u_fireballCount; ++i) {
-        KilnInstance f = kiln_instances[u_firstFireball + i];
-        if (distance(centre, kilnSphereCentre(f)) + radius <= kilnSphereRadius(f)) return;
-    }
     float voxel = 2.0 / float(u_res);
     // In voxel units: the cube [lo, hi] and the voxels it overlaps.
     vec3 lo = (centre - radius + 1.0) / voxel, hi = (centre + radius + 1.0) / voxel;

@@ -455,7 +455,8 @@ TEST_CASE("voxelize fire_cover: every particle's whole cross-section lands in th
     // depth across a voxel of side h, so Σ cover · h² over the volume is the particles'
     // total cross-section Σ π r², counted here from the simulation, each times the part
     // of its bounding cube inside the box (the rest is in no voxel: particles rise to the
-    // ceiling); those wholly inside a fireball, none. Tolerance 0.5 %: each share is rounded to 1/4096 and stored as a half
+    // ceiling); those wholly inside a fireball, none (the host leaves them out of the
+    // scene's instances: host/scene/live_scene.cpp). Tolerance 0.5 %: each share is rounded to 1/4096 and stored as a half
     // float (relative 0.05 %); a particle dropped or counted twice among a few hundred,
     // or a share not normalised, moves it by more.
     Rig rig("", 64);
