@@ -172,7 +172,7 @@ public:
 
         glClearTexImage(ctx.internal("sums").id, 0, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
 
-        // The particles' cover first: the surfaces' lamp light goes through it.
+        // The particles' cover and the transmittance grid from it: the resolve reads the grid.
         if (fireCover) coverFire(ctx, coverer, fireResolve, fireMip, fireLight, res);
         rasterize(ctx, raster, res, particles && !splatParticles, !splatFireballs, !splatTumblers);
         if (splatter && !splat(ctx, splatter, res, splatParticles, splatFireballs)) return;

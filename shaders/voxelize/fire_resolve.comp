@@ -1,7 +1,7 @@
 #version 450 core
 // fire_cover, after fire_cover.comp: level 0 of `fire`, the particles' optical depth
-// across each voxel, from its fixed-point sums. Before the surfaces are lit, so that
-// their lamp light goes through it too (surface.glsl).
+// across each voxel, from its fixed-point sums, for its mips (fire_mip.comp) and the
+// lamp's transmittance grid (fire_transmittance.comp) that resolve.comp reads.
 layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
 
 #include "sums.glsl"
