@@ -13,7 +13,8 @@
 // feedback has settled); moving without fireballs (no particles, no moving emitters);
 // moving with bloom culled (composite does not read it); moving with bloom disabled;
 // the tumblers asleep and no balls (time runs, nothing moves; settled too); and one
-// marble bouncing among the sleeping tumblers. Per situation: each pass's median GPU and
+// marble bouncing among the sleeping tumblers, redrawing only the part of the picture it
+// changes (kiln/pass.hpp) and, to compare, all of it. Per situation: each pass's median GPU and
 // CPU ms over the frames it ran, how often it ran, and the median wall time per frame
 // (with a glFinish, what a user waits for), and the ratio to "moving".
 //
@@ -99,12 +100,18 @@ struct Situation {
     // Measured once converging passes have settled (App::settle: voxel_mip's feedback
     // runs 16 frames after the last change), as a scene at rest is seen for long.
     bool settled = false;
+    bool fullRedraw = false;  // frames where only bodies moved redraw it all (--full-redraw)
+    // Frames run before measuring: 3 (compiles, allocation, a first run after a change),
+    // or more to see what a scene costs long after it was loaded (the voxels' bounces
+    // fed back converge for 16 frames after a change to everything, and meanwhile every
+    // frame is redrawn whole).
+    int warmFrames = 3;
 };
 
 struct PassRowOut {
     std::string id, state;
     double gpuMs = 0, cpuMs = 0;
-    int ran = 0, skipped = 0;
+    int ran = 0, skipped = 0, partial = 0;
 };
 
 struct Outcome {
@@ -115,8 +122,8 @@ struct Outcome {
     std::vector<PassRowOut> passes;
 };
 
-// `frames` frames of one situation after 3 to settle (compiles, allocation, a first run
-// after a change), with skipping on as a user runs it.
+// `frames` frames of one situation after its warm-up frames, with skipping on as a user
+// runs it.
 Outcome runSituation(app::App& app, const Situation& s, int frames) {
     std::string error;
     if (!app.runtime().loadPipelineText(s.pipelineText, s.label, error) || !app.scene().load(s.sceneFile, std::nullopt, error)) {
@@ -124,8 +131,9 @@ Outcome runSituation(app::App& app, const Situation& s, int frames) {
         std::exit(1);
     }
     app.paused = false;
+    app.redrawParts = !s.fullRedraw;
     for (double t = 0.0; t < s.restSeconds; t += app.scene().dt()) app.scene().step();
-    for (int f = 0; f < 3; ++f) app.frame();
+    for (int f = 0; f < s.warmFrames; ++f) app.frame();
     if (s.settled) app.settle();
     app.paused = s.paused;
     app.frame();  // the paused state's first frame still runs what the last step changed
@@ -146,7 +154,7 @@ Outcome runSituation(app::App& app, const Situation& s, int frames) {
               app.scene().sim().particles().size(), app.scene().sim().balls().size(), {}};
     for (auto& r : app.runtime().stats())
         o.passes.push_back({r.id, r.state, r.ranFrames ? r.gpuMedianMs : 0.0, r.ranFrames ? r.cpuMedianMs : 0.0,
-                            r.ranFrames, r.skippedFrames});
+                            r.ranFrames, r.skippedFrames, r.partialFrames});
     return o;
 }
 
@@ -240,16 +248,16 @@ void reportOverhead(const std::vector<Outcome>& outcomes, const Args& args, std:
 
 // kiln-bench-skip's table: per situation, every pass's state and times.
 void reportSkip(const std::vector<Outcome>& outcomes, std::ofstream& csv) {
-    csv << "situation,pass,state,gpu_ms,cpu_ms,ran,skipped,frame_ms,frame_ratio\n";
+    csv << "situation,pass,state,gpu_ms,cpu_ms,ran,skipped,partial,frame_ms,frame_ratio\n";
     const double moving = outcomes.front().frameMs;
     for (const Outcome& r : outcomes) {
         std::printf("%s: %.3f ms per frame (%.4f of moving); t = %.3f s, %zu balls, %zu particles\n", r.label.c_str(),
                     r.frameMs, r.frameMs / moving, r.simTime, r.balls, r.particles);
         for (auto& p : r.passes) {
-            std::printf("    %-12s %-14s gpu %8.3f  cpu %8.3f  ran %3d  skipped %3d\n", p.id.c_str(), p.state.c_str(),
-                        p.gpuMs, p.cpuMs, p.ran, p.skipped);
+            std::printf("    %-12s %-14s gpu %8.3f  cpu %8.3f  ran %3d  skipped %3d  part of the picture %3d\n",
+                        p.id.c_str(), p.state.c_str(), p.gpuMs, p.cpuMs, p.ran, p.skipped, p.partial);
             csv << '"' << r.label << "\"," << p.id << ',' << p.state << ',' << p.gpuMs << ',' << p.cpuMs << ','
-                << p.ran << ',' << p.skipped << ',' << r.frameMs << ',' << r.frameMs / moving << '\n';
+                << p.ran << ',' << p.skipped << ',' << p.partial << ',' << r.frameMs << ',' << r.frameMs / moving << '\n';
         }
     }
 }
@@ -285,8 +293,10 @@ int main(int argc, char** argv) {
         situations.push_back({"moving, bloom culled", editedPipeline(pipeline, true, false), o.scene, false});
         situations.push_back({"moving, bloom disabled", editedPipeline(pipeline, false, true), o.scene, false});
         situations.push_back({"asleep (tumblers at rest, no balls)", pipeline, restingScene(o.scene, args.outDir, false), false, 1.0, true});
-        situations.push_back(
-            {"one marble moving, the rest asleep", pipeline, restingScene(o.scene, args.outDir, true), false, 1.0});
+        const std::string oneMarble = restingScene(o.scene, args.outDir, true);
+        situations.push_back({"one marble moving, the rest asleep", pipeline, oneMarble, false, 1.0, false, false, 24});
+        situations.push_back({"one marble moving, the whole picture redrawn (--full-redraw)", pipeline, oneMarble,
+                              false, 1.0, false, true, 24});
     }
     const std::vector<Outcome> outcomes = measureRounds(app, situations, args);
 

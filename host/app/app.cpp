@@ -9,6 +9,7 @@
 #include <cmath>
 
 #include "kiln/log.hpp"
+#include "scene/redraw_region.hpp"
 
 namespace kiln::app {
 
@@ -45,6 +46,7 @@ bool App::init(const Options& o, std::string& error) {
     keepFreedHeap();
     options_ = o;
     paused = o.paused;
+    redrawParts = !o.fullRedraw;
     viewed = o.view;
     run::RuntimeOptions ro;
     // --shaders and --modules may list several directories, separated by ':'; the first
@@ -132,6 +134,32 @@ SceneView App::buildView() {
     return v;
 }
 
+// A frame in which nothing but tumblers and marbles changed redraws where they were
+// and are, their shadows and the light near them (scene/redraw_region.hpp), and one
+// band of rows (kiln/pass.hpp, REDRAWING PART OF THE PICTURE); any other change, or a
+// footprint over half the picture, redraws it all.
+void App::chooseRedraw(const SceneView& view, FrameInfo& info) {
+    const std::optional<std::vector<glm::vec4>> moved = renderer_.takeMovedBodies();
+    bool onlyBodies = true;
+    for (int i = 0; i < kSceneCategoryCount; ++i) {
+        const uint32_t c = 1u << i;
+        // Time moves on with the bodies; a pass that reads it redraws all (the runtime).
+        if (c != kSceneTumblers && c != kSceneMarbles && c != kSceneTime && view.versions[i] != lastVersions_[i])
+            onlyBodies = false;
+        lastVersions_[i] = view.versions[i];
+    }
+    if (!redrawParts || !onlyBodies || !moved || moved->empty()) return;
+    scene::RedrawView where;
+    where.viewProj = view.frame.viewProj;
+    where.width = options_.width, where.height = options_.height;
+    where.lampCentre = glm::vec3(view.frame.lightPos);
+    where.lampRadius = view.frame.lightPos.w;
+    const std::optional<PixelRect> changed = scene::changedPixels(*moved, where);
+    if (!changed || 2.0 * changed->width * changed->height > double(options_.width) * options_.height) return;
+    info.redraw[info.redrawCount++] = scene::redrawBand(redrawBand_++, options_.width, options_.height);
+    if (!changed->empty()) info.redraw[info.redrawCount++] = *changed;
+}
+
 // Fixed steps for `wallSeconds` of wall clock × timeScale, while stepping fits in the
 // budget; what it cannot step in time is dropped and counted.
 int App::stepRealTime(double wallSeconds, std::chrono::steady_clock::time_point start) {
@@ -188,6 +216,7 @@ void App::frame(double wallSeconds) {
     info.index = frameIndex_++;
     info.time = scene_.time();
     info.dt = scene_.dt();
+    chooseRedraw(view, info);
     runtime_.renderFrame(view, renderer_, info);
 }
 

@@ -62,8 +62,12 @@ public:
     // producer (from the next frame on), as --view does.
     std::string viewed;
 
+    // Frames in which only bodies moved redraw part of the picture (--full-redraw: off).
+    bool redrawParts = true;
+
 private:
     SceneView buildView();
+    void chooseRedraw(const SceneView&, FrameInfo&);
 
     int stepRealTime(double wallSeconds, std::chrono::steady_clock::time_point start);
 
@@ -76,6 +80,8 @@ private:
     uint64_t frameIndex_ = 0;
     glm::mat4 lastViewProj_{0.0f};
     uint64_t cameraVersion_ = 0, timeVersion_ = 0;
+    uint64_t lastVersions_[kSceneCategoryCount] = {};  // the last frame's, for chooseRedraw
+    int redrawBand_ = 0;
     double accumulator_ = 0.0;
     double lastSimTime_ = 0.0;   // the scene's time after the last frame (a smaller one: reset or reload)
     std::string requestedView_;  // what the runtime was last asked to keep un-culled

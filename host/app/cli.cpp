@@ -29,6 +29,7 @@ usage: kiln [options]
   --stats           print the per-pass time table (GPU timer queries + CPU clock)
   --no-live         do not watch files for live reloading
   --no-skip         run every pass every frame, even when nothing it reads changed
+  --full-redraw     redraw the whole picture when only bodies moved (not their footprints)
   --plan            print the compiled plan (order, culled passes and why)
   --dot FILE        write the plan as graphviz dot
   --view PASS.OUT   show this texture instead of the graph output (un-culls its producer)
@@ -123,7 +124,7 @@ constexpr Switch kSwitches[] = {{"--help", &Options::help, true},        {"-h", 
                                 {"--headless", &Options::headless, true}, {"--stats", &Options::stats, true},
                                 {"--no-live", &Options::live, false},     {"--no-skip", &Options::noSkip, true},
                                 {"--plan", &Options::printPlan, true},    {"--paused", &Options::paused, true},
-                                {"--watch", &Options::watch, true}};
+                                {"--watch", &Options::watch, true},       {"--full-redraw", &Options::fullRedraw, true}};
 
 // Options whose value is kept as text (paths, a texture name).
 struct TextOption {

@@ -22,6 +22,7 @@ struct Options {
     std::string dump;         // directory for every texture of the last frame
     bool stats = false;
     bool noSkip = false;      // run every pass every frame (for timing tables)
+    bool fullRedraw = false;  // no partial frames when only bodies moved (App::redrawParts)
     bool printPlan = false;
     std::string dot;          // write the plan as graphviz
     uint64_t seed = kSceneSeed;  // kSceneSeed: the scene file's physics.seed

@@ -28,6 +28,8 @@ struct PassSlot {
     ProgramCache programs;
     std::optional<std::vector<uint64_t>> lastRunKey;  // empty: run next frame
     int settlingFrames = 0;                           // runs left that keepRunning asked for
+    bool lastRunByScene = false;                      // its last run changed only what bodies moving change
+    int convergingRuns = 0;                           // runs left of settling after a change to everything
     std::string settlingReason;
     std::string error;                                // why the last execute failed
     std::string loggedError;                          // the last error printed (once each)

@@ -44,7 +44,7 @@ void PassTimings::reset() {
     collectGpu();
     gpu_.clear();
     cpu_.clear();
-    ranFrames = skippedFrames = 0;
+    ranFrames = skippedFrames = partialFrames = 0;
 }
 
 PassRow PassTimings::row(const std::string& id, const std::string& module) const {
@@ -59,6 +59,7 @@ PassRow PassTimings::row(const std::string& id, const std::string& module) const
     r.cpuMedianMs = cpu_.empty() ? 0.0 : median(cpu_);
     r.ranFrames = ranFrames;
     r.skippedFrames = skippedFrames;
+    r.partialFrames = partialFrames;
     r.ranThisFrame = state == "ran" || state == "nothing to do";
     return r;
 }

@@ -19,6 +19,7 @@ struct PassRow {
     double cpuMs = 0.0;
     double gpuMedianMs = -1.0, cpuMedianMs = 0.0;
     int ranFrames = 0, skippedFrames = 0;
+    int partialFrames = 0;      // runs handed part of the picture to redraw (FrameInfo::redraw)
     bool ranThisFrame = false;  // ran or nothing to do; skipped/culled/disabled/error cost 0
 };
 
@@ -30,6 +31,7 @@ public:
     gl::GpuTimer timer;
     std::string state = "not run", why;
     int ranFrames = 0, skippedFrames = 0;
+    int partialFrames = 0;  // of ranFrames, those handed part of the picture (FrameInfo::redraw)
 
     void addCpu(double ms);
     // Harvests finished GPU queries; never waits.

@@ -275,6 +275,29 @@ std::vector<uint64_t> Runtime::runKey(const graph::PlannedPass& planned, const P
     return key;
 }
 
+// Whether the only reasons this pass runs are bodies moving (kiln/pass.hpp, REDRAWING
+// PART OF THE PICTURE): the frame says only bodies moved, the pass ran last time, and
+// what differs from that run's key is scene categories it reads (not time) or inputs
+// whose producers last ran for the same reason. A parameter, a program, a size, a
+// failed or settling run, time itself, or an input a producer rewrote for another
+// reason: everything.
+bool Runtime::runsForBodiesOnly(const graph::PlannedPass& planned, const PassSlot& slot,
+                                const std::vector<uint64_t>& key, bool settling, const FrameInfo& frame) const {
+    if (frame.redrawCount == 0 || settling || planned.decl.timeDependent || !slot.lastRunKey ||
+        slot.lastRunKey->size() != key.size())
+        return false;
+    const std::vector<uint64_t>& last = *slot.lastRunKey;
+    const size_t inputs = planned.bindings.size(), scene = inputs + kSceneCategoryCount;
+    const size_t time = inputs + size_t(sceneCategoryIndex(kSceneTime));
+    for (size_t k = 0; k < key.size(); ++k) {
+        if (key[k] == last[k] || (k >= inputs && k < scene && k != time)) continue;
+        if (k >= scene) return false;  // the output size or the programs
+        const graph::Binding& b = planned.bindings[k];
+        if (!b.bound() || !slots_[static_cast<size_t>(b.producer)]->lastRunByScene) return false;
+    }
+    return true;
+}
+
 void Runtime::renderFrame(const SceneView& view, const SceneDraw& scene, const FrameInfo& frameIn) {
     const auto start = std::chrono::steady_clock::now();
     cost_ = {};
@@ -325,13 +348,15 @@ void Runtime::runPass(size_t i, const FrameResources& shared, const SceneView& v
         ++t.skippedFrames;
         return t.note("skipped", "inputs, parameters and scene unchanged");
     }
+    FrameInfo passFrame = frame;
+    if (!runsForBodiesOnly(planned, slot, key, settling, frame)) passFrame.redrawCount = 0;
     if (settling) --slot.settlingFrames;
     else slot.settlingFrames = 0;  // a change: the pass says again whether it needs more frames
 
     resetGlState();
     shared.scene.bindInstances();
     slot.error.clear();
-    HostPassContext ctx(shared, slot, planned, view, frame);
+    HostPassContext ctx(shared, slot, planned, view, passFrame);
     if (settling) ctx.markSettling();
     const auto cpuStart = std::chrono::steady_clock::now();
     std::optional<std::string> fault;
@@ -367,10 +392,26 @@ void Runtime::runPass(size_t i, const FrameResources& shared, const SceneView& v
     slot.loggedError.clear();
     ++t.ranFrames;
     slot.lastRunKey = runKey(planned, slot, view);
+    // A pass still converging after a change that touched everything (keepRunning:
+    // voxel bounces fed back) changes its outputs everywhere for that many runs more,
+    // whatever moved since.
+    bool byScene = passFrame.redrawCount > 0;
+    if (!byScene) slot.convergingRuns = slot.settlingFrames;
+    else if (slot.convergingRuns > 0) --slot.convergingRuns, byScene = false;
+    slot.lastRunByScene = byScene;
     if (ctx.nothing()) return t.note("nothing to do", *ctx.nothing());
-    t.note("ran", slot.settlingFrames > 0 ? str("settling (", slot.settlingReason, "): ", slot.settlingFrames,
-                                                 slot.settlingFrames == 1 ? " more frame" : " more frames")
-                                           : std::string());
+    std::string why = slot.settlingFrames > 0 ? str("settling (", slot.settlingReason, "): ", slot.settlingFrames,
+                                                    slot.settlingFrames == 1 ? " more frame" : " more frames")
+                                              : std::string();
+    if (passFrame.redrawCount > 0) {
+        ++t.partialFrames;
+        double pixels = 0.0;
+        for (int r = 0; r < passFrame.redrawCount; ++r)
+            pixels += double(passFrame.redraw[r].width) * passFrame.redraw[r].height;
+        why = str("bodies moved: ", int(std::lround(100.0 * pixels / (double(frame.outputWidth) * frame.outputHeight))),
+                  " % of the picture to redraw");
+    }
+    t.note("ran", why);
     for (auto& [name, tex] : slot.textures) tex.version = ++versionCounter_;
 }
 

@@ -125,6 +125,8 @@ private:
     void createPassObject(PassSlot&, const graph::PlannedPass&);
     void allocateTextures(size_t pass);
     std::vector<uint64_t> runKey(const graph::PlannedPass&, const PassSlot&, const SceneView&) const;
+    bool runsForBodiesOnly(const graph::PlannedPass&, const PassSlot&, const std::vector<uint64_t>& key, bool settling,
+                           const FrameInfo&) const;
     void runPass(size_t pass, const FrameResources&, const SceneView&, const FrameInfo&);
     void resetGlState() const;
     void retireFaultedObject(PassSlot&);

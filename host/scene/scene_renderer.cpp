@@ -1,6 +1,8 @@
 #include "scene/scene_renderer.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <cstring>
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -71,6 +73,10 @@ void SceneRenderer::setLook(const SceneLook& look) {
     // The lamp dome: its mesh is already in world space.
     staticInstances_.push_back(
         {I, glm::vec4(look.lampColor, 0.0f), glm::vec4(look.lampColor * look.lampIntensity, 0.0f)});
+    // The tumbler's mesh about its origin (the lower ball's centre): the upper ball's top.
+    const float upperCentre = (look.tumblerB - look.tumblerT) / std::sin(look.tumblerAlpha);
+    tumblerRadius_ = std::max(look.tumblerB, upperCentre + look.tumblerT) * 1.05f;
+    movedUnbounded_ = true;
     // New meshes change what every category looks like, whatever its instances say.
     for (int i = 0; i < kSceneGeometryCount; ++i) ++versions_[i], hashes_[i] = 0;
     noteContents(kSceneBox, staticInstances_.data(), walls);
@@ -96,7 +102,35 @@ void SceneRenderer::setBodies(const std::vector<BodyInstance>& bodies) {
                     {b.model, glm::vec4(b.albedo, 0.0f), glm::vec4(b.emissive, b.highlighted ? 1.0f : 0.0f)});
         noteContents(c, bodyInstances_.data() + first, bodyInstances_.size() - first);
     }
+    noteMovedBodies();
     dirty_ = true;
+}
+
+// Bodies are matched by their place in the list (upload() reorders bodyInstances_, so
+// the list as given is kept apart); one added or removed cannot be bounded so.
+void SceneRenderer::noteMovedBodies() {
+    if (bodyInstances_.size() != givenBodies_.size()) movedUnbounded_ = true;
+    auto sphere = [&](const GpuInstance& g, size_t i) {
+        const float scale = std::max({glm::length(glm::vec3(g.model[0])), glm::length(glm::vec3(g.model[1])),
+                                      glm::length(glm::vec3(g.model[2]))});
+        const float meshRadius = i < count(kSceneTumblers) ? tumblerRadius_ : 1.0f;
+        return glm::vec4(glm::vec3(g.model[3]), scale * meshRadius);
+    };
+    if (!movedUnbounded_)
+        for (size_t i = 0; i < bodyInstances_.size(); ++i)
+            if (std::memcmp(&bodyInstances_[i], &givenBodies_[i], sizeof(GpuInstance)) != 0) {
+                movedBodies_.push_back(sphere(givenBodies_[i], i));
+                movedBodies_.push_back(sphere(bodyInstances_[i], i));
+            }
+    givenBodies_ = bodyInstances_;
+}
+
+std::optional<std::vector<glm::vec4>> SceneRenderer::takeMovedBodies() {
+    std::optional<std::vector<glm::vec4>> moved;
+    if (!movedUnbounded_) moved = std::move(movedBodies_);
+    movedBodies_.clear();
+    movedUnbounded_ = false;
+    return moved;
 }
 
 void SceneRenderer::setParticles(const std::vector<ParticleInstance>& particles) {

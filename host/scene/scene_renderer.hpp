@@ -10,6 +10,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "kiln/gl.hpp"
@@ -75,6 +76,10 @@ public:
     uint32_t count(SceneCategory single) const { return counts_[sceneCategoryIndex(single)]; }
     // Changes whenever that geometry category's instance contents changed.
     uint64_t version(SceneCategory single) const { return versions_[sceneCategoryIndex(single)]; }
+    // The bodies (tumblers, marbles, fireballs) that changed since the last call, as
+    // spheres round where each was and where it is (xyz centre, w radius); nullopt when
+    // the change cannot be put so (bodies added or removed, a new look).
+    std::optional<std::vector<glm::vec4>> takeMovedBodies();
 
 private:
     enum MeshId {
@@ -89,6 +94,7 @@ private:
     // screen and keeps the three counts in sphereLevels_.
     void sortSpheresBySize();
     void noteContents(SceneCategory, const GpuInstance* begin, size_t count);
+    void noteMovedBodies();
 
     std::array<MeshRange, kMeshCount> meshes_{};
     gl::Buffer vertexBuffer_, indexBuffer_;
@@ -101,6 +107,10 @@ private:
     float pixelsPerUnit_ = 0.0f;
     std::array<std::array<uint32_t, 3>, 2> sphereLevels_{};  // marbles, fireballs: near, mid, far
     bool dirty_ = true;
+    std::vector<GpuInstance> givenBodies_;  // the bodies as setBodies last got them
+    std::vector<glm::vec4> movedBodies_;
+    bool movedUnbounded_ = true;
+    float tumblerRadius_ = 1.0f;  // the tumbler mesh's bounding ball about its origin
     uint32_t counts_[kSceneGeometryCount] = {};
     uint64_t versions_[kSceneGeometryCount] = {};
     uint64_t hashes_[kSceneGeometryCount] = {};

@@ -63,7 +63,15 @@ public:
         kiln::gl::bindTexture(brightPass, "u_color", in.id);
         kiln::gl::bindImage(brightPass, "u_bright", bright.id, 0, false, GL_WRITE_ONLY, GL_RGBA16F);
         kiln::gl::bindStorageBuffer(brightPass, "AnyBright", anyBright_.id());
-        glDispatchCompute(GLuint((bright.width + 7) / 8), GLuint((bright.height + 7) / 8), 1);
+        // Where only bodies moved, only what they change (kiln/pass.hpp): the vertical
+        // blur reads `ping` `taps` texels up and down, which read `bright` `taps` left and
+        // right, so each stage covers the next one's rectangles grown by `taps` (and the
+        // flag sees every texel the blur reads); `bloom` one texel spare for composite's
+        // filtered read.
+        for (const kiln::PixelRect& r : kiln::redrawRects(ctx, bright.width, bright.height, 2 * taps + 1)) {
+            glUniform2i(glGetUniformLocation(brightPass, "u_origin"), r.x, r.y);
+            glDispatchCompute(GLuint((r.width + 7) / 8), GLuint((r.height + 7) / 8), 1);
+        }
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
 
         // 2. Horizontal blur → ping; vertical → bloom.
@@ -81,18 +89,22 @@ public:
         // Black where nothing is drawn (blur.vert collapses the triangle when nothing is bright).
         const float black[4] = {0.0f, 0.0f, 0.0f, 1.0f};
         if (!ctx.framebuffer({"ping"})) return;
-        glClearBufferfv(GL_COLOR, 0, black);
         glUniform2f(glGetUniformLocation(blur, "u_direction"), 1.0f, 0.0f);
         glUniform1f(glGetUniformLocation(blur, "u_gain"), 1.0f);
         kiln::gl::bindStorageBuffer(blur, "AnyBright", anyBright_.id());
         kiln::gl::bindTexture(blur, "u_src", bright.id);
-        ctx.drawFullscreenTriangle();
+        kiln::forEachRedrawRect(ctx, bright.width, bright.height, taps + 1, [&] {
+            glClearBufferfv(GL_COLOR, 0, black);
+            ctx.drawFullscreenTriangle();
+        });
         if (!ctx.framebuffer({"bloom"})) return;
-        glClearBufferfv(GL_COLOR, 0, black);
         glUniform2f(glGetUniformLocation(blur, "u_direction"), 0.0f, 1.0f);
         glUniform1f(glGetUniformLocation(blur, "u_gain"), ctx.getFloat("intensity"));
         kiln::gl::bindTexture(blur, "u_src", ctx.internal("ping").id);
-        ctx.drawFullscreenTriangle();
+        kiln::forEachRedrawRect(ctx, bright.width, bright.height, 1, [&] {
+            glClearBufferfv(GL_COLOR, 0, black);
+            ctx.drawFullscreenTriangle();
+        });
     }
 
 private:

@@ -112,17 +112,25 @@ public:
             glSamplerParameteri(compareSampler_.id(), GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
             glSamplerParameteri(compareSampler_.id(), GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
         }
-        draw(ctx, program);
-        // The near field again, per pixel, over its screen rectangle only.
+        // Where only bodies moved, only what they change (kiln/pass.hpp).
+        const kiln::TextureRef& color = ctx.output("color");
+        kiln::forEachRedrawRect(ctx, color.width, color.height, 0, [&] { draw(ctx, program); });
+        // The near field again, per pixel, over its screen rectangle only (within each
+        // rectangle to redraw).
         if (nearField) {
             const glm::vec4 lamp = ctx.scene().frame.lightPos;
             const Rect r = screenRect(ctx, glm::vec3(lamp), lamp.w + ctx.getFloat("lamp_near_field"));
-            if (r.width > 0 && r.height > 0) {
+            kiln::forEachRedrawRect(ctx, color.width, color.height, 0, [&] {
+                GLint box[4] = {0, 0, color.width, color.height};
+                if (glIsEnabled(GL_SCISSOR_TEST)) glGetIntegerv(GL_SCISSOR_BOX, box);
+                const int x0 = std::max(r.x, box[0]), x1 = std::min(r.x + r.width, box[0] + box[2]);
+                const int y0 = std::max(r.y, box[1]), y1 = std::min(r.y + r.height, box[1] + box[3]);
+                if (x1 <= x0 || y1 <= y0) return;
                 glEnable(GL_SCISSOR_TEST);
-                glScissor(r.x, r.y, r.width, r.height);
+                glScissor(x0, y0, x1 - x0, y1 - y0);
                 draw(ctx, nearProgram);
-                glDisable(GL_SCISSOR_TEST);
-            }
+            });
+            glDisable(GL_SCISSOR_TEST);
         }
         kiln::gl::bindSamplerObject(program, "u_shadowMap", 0);  // the host resets textures, not samplers
     }

@@ -255,7 +255,12 @@ public:
         glUniform1f(loc("u_diameterOffset"), ctx.getFloat("diameter_offset"));
         glUniform1f(loc("u_voxelRes"), float(voxels.width));
         glUniform1i(loc("u_stride"), traceStep);
-        ctx.drawFullscreenTriangle();
+        // Where only bodies moved, only what they change (kiln/pass.hpp), grown by the
+        // two traced texels each side the upsampling reads; the reuse variant keeps its
+        // own history of every tile and redraws all.
+        const kiln::TextureRef& target = upsampled ? ctx.internal("samples") : ctx.output("indirect");
+        if (reuse) ctx.drawFullscreenTriangle();
+        else kiln::forEachRedrawRect(ctx, target.width, target.height, 2, [&] { ctx.drawFullscreenTriangle(); });
         if (reuse) keepHistory(ctx);
 
         if (upsampled) {
@@ -268,7 +273,10 @@ public:
             glUniform1i(glGetUniformLocation(upsample, "u_stride"), stride);
             glUniform1i(glGetUniformLocation(upsample, "u_outputStep"), divisor);
             glUniform1f(glGetUniformLocation(upsample, "u_planeTolerance"), ctx.getFloat("upsample_tolerance"));
-            ctx.drawFullscreenTriangle();
+            // One texel spare each side: composite reads `indirect` filtered.
+            const kiln::TextureRef& indirect = ctx.output("indirect");
+            if (reuse) ctx.drawFullscreenTriangle();
+            else kiln::forEachRedrawRect(ctx, indirect.width, indirect.height, 1, [&] { ctx.drawFullscreenTriangle(); });
         }
     }
 

@@ -47,40 +47,46 @@ public:
             bakedTexture_ = wood.id, bakedLight_ = f.woodLight, bakedDark_ = f.woodDark, bakedWith_ = bake;
         }
         if (!ctx.framebuffer({"albedo", "normal", "emissive"}, "depth")) return;
-        const float zero[4] = {0, 0, 0, 0}, one = 1.0f;
-        for (int i = 0; i < 3; ++i) glClearBufferfv(GL_COLOR, i, zero);
-        glClearBufferfv(GL_DEPTH, 0, &one);
-        glEnable(GL_DEPTH_TEST);
-        glDepthFunc(GL_LESS);
-        glUseProgram(program);
-        kiln::gl::bindTexture(program, "u_wood", wood.id);
-        kiln::DrawFilter filter;
-        filter.categories = kiln::kSceneGeometry;
-        if (!particles || points) filter.categories &= ~kiln::kSceneParticles;
-        // The bodies are closed, so their back faces never show: culled, they cost
-        // llvmpipe no setup (13.3 against 16.4 ms at 720²), and no back face wins a
-        // depth tie at a silhouette (3 pixels of 360² did). The walls and the lamp's dome
-        // are open surfaces, seen from either side.
-        filter.categories &= ~kiln::kSceneBodies;
-        ctx.drawScene(filter);
-        glEnable(GL_CULL_FACE);
-        glCullFace(GL_BACK);
-        ctx.drawScene({.categories = kiln::kSceneBodies});
-        glDisable(GL_CULL_FACE);
+        // Where only bodies moved, only what they change (kiln/pass.hpp): the clears
+        // and the draws are scissored to it, the rest keeps last frame's surfaces.
+        const kiln::TextureRef& target = ctx.output("albedo");
+        kiln::forEachRedrawRect(ctx, target.width, target.height, 0, [&] {
+            const float zero[4] = {0, 0, 0, 0}, one = 1.0f;
+            for (int i = 0; i < 3; ++i) glClearBufferfv(GL_COLOR, i, zero);
+            glClearBufferfv(GL_DEPTH, 0, &one);
+            glEnable(GL_DEPTH_TEST);
+            glDepthFunc(GL_LESS);
+            glUseProgram(program);
+            kiln::gl::bindTexture(program, "u_wood", wood.id);
+            kiln::DrawFilter filter;
+            filter.categories = kiln::kSceneGeometry;
+            if (!particles || points) filter.categories &= ~kiln::kSceneParticles;
+            // The bodies are closed, so their back faces never show: culled, they cost
+            // llvmpipe no setup (13.3 against 16.4 ms at 720²), and no back face wins a
+            // depth tie at a silhouette (3 pixels of 360² did). The walls and the lamp's dome
+            // are open surfaces, seen from either side.
+            filter.categories &= ~kiln::kSceneBodies;
+            ctx.drawScene(filter);
+            glEnable(GL_CULL_FACE);
+            glCullFace(GL_BACK);
+            ctx.drawScene({.categories = kiln::kSceneBodies});
+            glDisable(GL_CULL_FACE);
 
-        // Thousands of particles a few pixels wide: one point each, not 8 triangles
-        // (4 000 octahedra cost the G-buffer 15 ms at 720² on llvmpipe).
-        const uint32_t count = ctx.scene().count(kiln::kSceneParticles);
-        if (points && count > 0) {
-            if (!pointsVao_) pointsVao_ = kiln::gl::createVertexArray();
-            glUseProgram(pointProgram);
-            glUniform1ui(glGetUniformLocation(pointProgram, "u_first"), ctx.scene().firstInstance(kiln::kSceneParticles));
-            glEnable(GL_PROGRAM_POINT_SIZE);
-            glBindVertexArray(pointsVao_.id());
-            glDrawArrays(GL_POINTS, 0, GLsizei(count));
-            glBindVertexArray(0);
-            glDisable(GL_PROGRAM_POINT_SIZE);
-        }
+            // Thousands of particles a few pixels wide: one point each, not 8 triangles
+            // (4 000 octahedra cost the G-buffer 15 ms at 720² on llvmpipe).
+            const uint32_t count = ctx.scene().count(kiln::kSceneParticles);
+            if (points && count > 0) {
+                if (!pointsVao_) pointsVao_ = kiln::gl::createVertexArray();
+                glUseProgram(pointProgram);
+                glUniform1ui(glGetUniformLocation(pointProgram, "u_first"),
+                             ctx.scene().firstInstance(kiln::kSceneParticles));
+                glEnable(GL_PROGRAM_POINT_SIZE);
+                glBindVertexArray(pointsVao_.id());
+                glDrawArrays(GL_POINTS, 0, GLsizei(count));
+                glBindVertexArray(0);
+                glDisable(GL_PROGRAM_POINT_SIZE);
+            }
+        });
     }
 
 private:

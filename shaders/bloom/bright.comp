@@ -12,10 +12,11 @@ layout(binding = 0) uniform sampler2D u_color;
 layout(binding = 0, rgba16f) uniform writeonly image2D u_bright;
 layout(std430, binding = 1) buffer AnyBright { uint u_anyBright; };
 uniform float u_threshold;
+uniform ivec2 u_origin;  // the rectangle dispatched: all of it, or a part to redraw
 
 void main() {
     ivec2 size = textureSize(u_color, 0);
-    ivec2 q = ivec2(gl_GlobalInvocationID.xy);
+    ivec2 q = u_origin + ivec2(gl_GlobalInvocationID.xy);
     vec3 sum = vec3(0.0);
     float m = 0.0;
     for (int k = 0; k < 4; ++k) {

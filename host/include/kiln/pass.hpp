@@ -77,6 +77,22 @@
 //   after this run even if nothing changes. A call from one of those frames does not
 //   extend them, so a paused frame settles and then costs nothing again.
 //
+// REDRAWING PART OF THE PICTURE
+//   When the only change since your last run is bodies moving (a marble rolling among
+//   sleeping tumblers, nothing else), the host hands you the part of the picture they
+//   can change: ctx.frame().redraw, up to two rectangles in output pixels (the moved
+//   bodies' footprints with their shadows and nearby light, and one band of rows that
+//   moves down the picture each such frame, so light that changes a little everywhere
+//   is caught up with within kRedrawBands frames). Outside them your screen-sized
+//   outputs already hold this frame's picture: a pass that draws the screen may redraw
+//   only those rectangles (kiln::forEachRedrawRect sets the scissor for each, scaled
+//   to your target; kiln::redrawRects gives them to a compute dispatch). A pass that
+//   fills a screen-sized output from a neighbourhood of its inputs grows them by its
+//   reach. frame().redrawCount is 0 whenever anything else changed (the camera, the
+//   lamp, a parameter, a program, a size, time for a pass that reads it, a pass before
+//   yours still converging, your last run failed): redraw everything. Ignoring it is
+//   always correct, only slower.
+//
 // EXECUTING
 //   ctx.input/output/internal("name") give a TextureRef (GL name + shape); asking for
 //   a name you did not declare fails the pass with a message naming it.
@@ -152,11 +168,13 @@
 //   kiln_add_pass (cmake/KilnModule.cmake).
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <initializer_list>
 #include <string>
 #include <string_view>
 #include <variant>
+#include <vector>
 
 #include "kiln/declare.hpp"
 #include "kiln/gl.hpp"
@@ -168,9 +186,10 @@ namespace kiln {
 // Bump when anything in this header (or what it includes) changes layout or vtables,
 // or when what the host does for a pass changes (6: the host issues the barrier
 // between passes; 7: GpuFrame::boxWalls; 8: PassContext::keepRunning; 9:
-// SizeRule::capSource and Lod::Medium; 10: ProgramBuild::portability), so a module
+// SizeRule::capSource and Lod::Medium; 10: ProgramBuild::portability; 11:
+// FrameInfo::redraw), so a module
 // built for other terms is refused by name, not run.
-inline constexpr uint32_t kPassAbiVersion = 10;
+inline constexpr uint32_t kPassAbiVersion = 11;
 
 struct TextureRef {
     GLuint id = 0;
@@ -180,11 +199,26 @@ struct TextureRef {
     bool bound = false;         // false: a fallback texture stands in
 };
 
+// A rectangle of pixels as glScissor takes it: lower-left corner, width and height.
+struct PixelRect {
+    int x = 0, y = 0, width = 0, height = 0;
+    bool empty() const { return width <= 0 || height <= 0; }
+    friend bool operator==(const PixelRect&, const PixelRect&) = default;
+};
+
+// The rows of the picture are refreshed in this many bands, one per frame that redraws
+// only part of it (REDRAWING PART OF THE PICTURE).
+inline constexpr int kRedrawBands = 8;
+
 struct FrameInfo {
     uint64_t index = 0;
     double time = 0.0;          // simulation seconds
     double dt = 0.0;
     int outputWidth = 0, outputHeight = 0;
+    // What this run must redraw, in output pixels: the whole output when redrawCount
+    // is 0, else only redraw[0 .. redrawCount).
+    int redrawCount = 0;
+    PixelRect redraw[2];
 };
 
 class PassContext {
@@ -222,6 +256,39 @@ public:
     virtual PassDeclaration declare() const = 0;
     virtual void execute(PassContext& ctx) = 0;
 };
+
+// The rectangles of a `width`×`height` target to redraw this run: the frame's (see
+// REDRAWING PART OF THE PICTURE) scaled onto it, rounded outwards and grown by `grow`
+// texels (for filters that read neighbours), clipped; or the whole target.
+inline std::vector<PixelRect> redrawRects(const PassContext& ctx, int width, int height, int grow) {
+    const FrameInfo& f = ctx.frame();
+    if (f.redrawCount == 0 || f.outputWidth <= 0 || f.outputHeight <= 0) return {PixelRect{0, 0, width, height}};
+    std::vector<PixelRect> rects;
+    for (int i = 0; i < f.redrawCount; ++i) {
+        const PixelRect& r = f.redraw[i];
+        auto lo = [&](int v, int target, int output) { return std::max(0, int(int64_t(v) * target / output) - grow); };
+        auto hi = [&](int v, int target, int output) {
+            return std::min(target, int((int64_t(v) * target + output - 1) / output) + grow);
+        };
+        const int x0 = lo(r.x, width, f.outputWidth), x1 = hi(r.x + r.width, width, f.outputWidth);
+        const int y0 = lo(r.y, height, f.outputHeight), y1 = hi(r.y + r.height, height, f.outputHeight);
+        if (x1 > x0 && y1 > y0) rects.push_back({x0, y0, x1 - x0, y1 - y0});
+    }
+    return rects;
+}
+
+// Runs `draw` once per rectangle of redrawRects with the scissor test on it, turned
+// off again after; once with the scissor off when the whole output is to be redrawn.
+template <class Draw>
+void forEachRedrawRect(const PassContext& ctx, int width, int height, int grow, Draw&& draw) {
+    if (ctx.frame().redrawCount == 0) return (void)draw();
+    glEnable(GL_SCISSOR_TEST);
+    for (const PixelRect& r : redrawRects(ctx, width, height, grow)) {
+        glScissor(r.x, r.y, r.width, r.height);
+        draw();
+    }
+    glDisable(GL_SCISSOR_TEST);
+}
 
 }  // namespace kiln
 
