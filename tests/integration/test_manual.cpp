@@ -76,12 +76,8 @@ TEST_CASE("the manual's tint pass multiplies what it reads by its tint, its para
     REQUIRE(app.runtime().loadPipelineText(pipeline, "manual.json", errors));
     app.frame();
     for (auto& e : app.runtime().activeErrors()) FAIL(e);
-    const TextureRef* in = app.runtime().findTexture("composite", "hdr");
-    const TextureRef* out = app.runtime().findTexture("tint", "color");
-    REQUIRE(in);
-    REQUIRE(out);
-    const FloatImage before = readTexture(in->id, in->target, in->format, in->width, in->height);
-    const FloatImage after = readTexture(out->id, out->target, out->format, out->width, out->height);
+    const FloatImage before = test::readOutput(app, "composite", "hdr");
+    const FloatImage after = test::readOutput(app, "tint", "color");
     REQUIRE(after.width == before.width);
     const float tint[3] = {0.25f, 1.0f, 2.0f};
     int lit = 0;

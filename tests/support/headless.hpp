@@ -7,8 +7,10 @@
 #include <memory>
 #include <string>
 
+#include "app/app.hpp"
 #include "app/cli.hpp"
 #include "app/context.hpp"
+#include "kiln/image_io.hpp"
 
 namespace kiln::test {
 
@@ -29,6 +31,14 @@ inline app::Options pausedHeadlessOptions(int size) {
     o.paused = true;
     o.live = false;
     return o;
+}
+
+// Pass `pass`'s texture `name` as the app's last frame left it, read back; fails the
+// test when the running plan has none.
+inline FloatImage readOutput(const app::App& app, const std::string& pass, const std::string& name) {
+    const TextureRef* t = app.runtime().findTexture(pass, name);
+    REQUIRE(t);
+    return readTexture(t->id, t->target, t->format, t->width, t->height);
 }
 
 }  // namespace kiln::test
