@@ -216,7 +216,9 @@ void App::frame(double wallSeconds) {
     info.index = frameIndex_++;
     info.time = scene_.time();
     info.dt = scene_.dt();
+    info.outputWidth = options_.width, info.outputHeight = options_.height;
     chooseRedraw(view, info);
+    lastFrame_ = info;
     runtime_.renderFrame(view, renderer_, info);
 }
 

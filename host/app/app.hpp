@@ -64,6 +64,8 @@ public:
 
     // Frames in which only bodies moved redraw part of the picture (--full-redraw: off).
     bool redrawParts = true;
+    // What the last frame was asked to redraw (FrameInfo::redraw; count 0: all of it).
+    const FrameInfo& lastFrame() const { return lastFrame_; }
 
 private:
     SceneView buildView();
@@ -82,6 +84,7 @@ private:
     uint64_t cameraVersion_ = 0, timeVersion_ = 0;
     uint64_t lastVersions_[kSceneCategoryCount] = {};  // the last frame's, for chooseRedraw
     int redrawBand_ = 0;
+    FrameInfo lastFrame_;
     double accumulator_ = 0.0;
     double lastSimTime_ = 0.0;   // the scene's time after the last frame (a smaller one: reset or reload)
     std::string requestedView_;  // what the runtime was last asked to keep un-culled

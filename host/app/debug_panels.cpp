@@ -292,6 +292,13 @@ void panelScene(WindowState& state) {
     if (ImGui::Button("fireball (F)")) sim.spawnRandom(sim::BallKind::Fireball);
     float scale = float(app.timeScale);
     if (ImGui::SliderFloat("time scale", &scale, 0.05f, 4.0f, "%.2fx", ImGuiSliderFlags_Logarithmic)) app.timeScale = scale;
+    ImGui::Checkbox("redraw only what moved", &app.redrawParts);
+    if (ImGui::IsItemHovered())
+        ImGui::SetTooltip("where only tumblers and marbles moved, redraw what they can change and one band of rows");
+    state.probe.item("redraw-parts");
+    ImGui::SameLine();
+    ImGui::Checkbox("outline it", &state.showRedraw);
+    state.probe.item("redraw-outline");
     ImGui::Text("t = %.2f s, %d steps this frame, %zu balls, %zu particles", app.scene().time(), app.lastSteps,
                 sim.balls().size(), sim.particles().size());
     // Real time unless stepping outgrew its budget: then say how far behind it fell.
@@ -359,6 +366,22 @@ void sidebarTabs(WindowState& state) {
 
 }  // namespace
 
+// The rectangles the last frame redrew, over the image (output pixels, y up); nothing
+// when it redrew all of it.
+static void outlineRedraw(const WindowState& state) {
+    const FrameInfo& f = state.app->lastFrame();
+    if (f.outputWidth <= 0 || f.outputHeight <= 0) return;
+    ImDrawList* fg = ImGui::GetForegroundDrawList();
+    const float sx = float(state.image.z) / float(f.outputWidth), sy = float(state.image.w) / float(f.outputHeight);
+    const float left = float(state.image.x), bottom = float(state.image.y + state.image.w);
+    for (int i = 0; i < f.redrawCount; ++i) {
+        const PixelRect& r = f.redraw[i];
+        fg->AddRect(ImVec2(left + float(r.x) * sx, bottom - float(r.y + r.height) * sy),
+                    ImVec2(left + float(r.x + r.width) * sx, bottom - float(r.y) * sy), IM_COL32(120, 255, 120, 230), 0.0f, 0,
+                    1.5f);
+    }
+}
+
 void drawSidebar(WindowState& state) {
     App& app = *state.app;
     const ImGuiIO& io = ImGui::GetIO();
@@ -403,6 +426,7 @@ void drawSidebar(WindowState& state) {
         }
     panelTrace(state);
     if (state.showGraph) panelGraph(state, &state.showGraph);
+    if (state.showRedraw) outlineRedraw(state);
 }
 
 namespace {

@@ -119,6 +119,7 @@ struct WindowState {
     double traceX = 0, traceY = 0;    // where the right button went down
     std::optional<glm::vec2> traceUv;
     bool showTrace = false;
+    bool showRedraw = false;          // outline the part of the picture the last frame redrew
     PixelTrace trace;
     TextureViewer viewer;
     CompareView compare;
