@@ -55,9 +55,9 @@ public:
         const float threshold = ctx.getFloat("threshold");
 
         // 1. Bright-pass + downsample, and the "anything bright" flag for the blur's early out.
-        if (!anyBright_) anyBright_ = kiln::gl::Buffer::create(4, nullptr, GL_DYNAMIC_STORAGE_BIT, "bloom.any_bright");
-        const GLuint zero = 0;
-        glNamedBufferSubData(anyBright_.id(), 0, 4, &zero);
+        if (!anyBright_) anyBright_ = kiln::gl::Buffer::create(20, nullptr, GL_DYNAMIC_STORAGE_BIT, "bloom.any_bright");
+        const GLuint none[5] = {0, ~0u, ~0u, 0, 0};  // the flag; the bright texels' rectangle, empty
+        glNamedBufferSubData(anyBright_.id(), 0, sizeof none, none);
         glUseProgram(brightPass);
         glUniform1f(glGetUniformLocation(brightPass, "u_threshold"), threshold);
         kiln::gl::bindTexture(brightPass, "u_color", in.id);
@@ -93,9 +93,12 @@ public:
         glUniform1f(glGetUniformLocation(blur, "u_gain"), 1.0f);
         kiln::gl::bindStorageBuffer(blur, "AnyBright", anyBright_.id());
         kiln::gl::bindTexture(blur, "u_src", bright.id);
+        glUniform2f(glGetUniformLocation(blur, "u_targetSize"), float(bright.width), float(bright.height));
+        if (!rectangleVao_) rectangleVao_ = kiln::gl::createVertexArray();
+        glBindVertexArray(rectangleVao_.id());
         kiln::forEachRedrawRect(ctx, bright.width, bright.height, taps + 1, [&] {
             glClearBufferfv(GL_COLOR, 0, black);
-            ctx.drawFullscreenTriangle();
+            glDrawArrays(GL_TRIANGLES, 0, 6);  // round the bright texels (bloom/blur.vert)
         });
         if (!ctx.framebuffer({"bloom"})) return;
         glUniform2f(glGetUniformLocation(blur, "u_direction"), 0.0f, 1.0f);
@@ -103,12 +106,14 @@ public:
         kiln::gl::bindTexture(blur, "u_src", ctx.internal("ping").id);
         kiln::forEachRedrawRect(ctx, bright.width, bright.height, 1, [&] {
             glClearBufferfv(GL_COLOR, 0, black);
-            ctx.drawFullscreenTriangle();
+            glDrawArrays(GL_TRIANGLES, 0, 6);
         });
+        glBindVertexArray(0);
     }
 
 private:
-    kiln::gl::Buffer anyBright_;  // 4 bytes: nonzero when a texel passed the threshold, GPU only
+    kiln::gl::Buffer anyBright_;  // nonzero when a texel passed the threshold, and their rectangle; GPU only
+    kiln::gl::VertexArrayHandle rectangleVao_;  // attribute-less: blur.vert makes the rectangle
 };
 
 }  // namespace

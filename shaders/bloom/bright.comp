@@ -10,7 +10,9 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(binding = 0) uniform sampler2D u_color;
 layout(binding = 0, rgba16f) uniform writeonly image2D u_bright;
-layout(std430, binding = 1) buffer AnyBright { uint u_anyBright; };
+// The flag, and the rectangle of the texels above the threshold (bloom/blur.vert draws
+// only round it).
+layout(std430, binding = 1) buffer AnyBright { uint u_anyBright, u_minX, u_minY, u_maxX, u_maxY; };
 uniform float u_threshold;
 uniform ivec2 u_origin;  // the rectangle dispatched: all of it, or a part to redraw
 
@@ -26,5 +28,9 @@ void main() {
         sum += l > u_threshold ? c * ((l - u_threshold) / l) : vec3(0.0);
     }
     if (all(lessThan(q, imageSize(u_bright)))) imageStore(u_bright, q, vec4(0.25 * sum, 1.0));
-    if (m > u_threshold) atomicOr(u_anyBright, 1u);
+    if (m > u_threshold) {
+        atomicOr(u_anyBright, 1u);
+        atomicMin(u_minX, uint(q.x)), atomicMin(u_minY, uint(q.y));
+        atomicMax(u_maxX, uint(q.x)), atomicMax(u_maxY, uint(q.y));
+    }
 }

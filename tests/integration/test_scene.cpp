@@ -254,6 +254,61 @@ TEST_CASE("bloom glows below the brightest emitter's luminance and is exactly bl
     CHECK(maxLuminance(rig.app, "bloom", "bloom") == 0.0f);
 }
 
+TEST_CASE("bloom's blur, drawn only round the bright texels, is the whole picture's Gaussian blur of them",
+          "[scene][gl]") {
+    // bloom/blur.vert draws each blur pass over the rectangle round what passed the
+    // threshold, grown by the blur's reach, and leaves the rest black. Checked against the
+    // same separable Gaussian done here on the CPU over the whole bright-pass texture
+    // (σ = radius/4 half-resolution texels, (radius+1)/2 taps a side, normalised, edges
+    // clamped, × intensity): equal within RGBA16F's rounding (2e-3 relative: stored
+    // twice in half floats) where it glows, exactly 0 where it does not. A rectangle one
+    // texel short cuts the glow's edge by its last tap's weight (≈ 0.05 of its light).
+    Rig rig({}, 192);
+    std::string errors;
+    REQUIRE(rig.app.runtime().loadPipelineText(bloomPipeline(1.0f), "bloom.json", errors));
+    rig.app.frame();
+    const FloatImage bright = test::readOutput(rig.app, "bloom", "bright");
+    const FloatImage bloom = test::readOutput(rig.app, "bloom", "bloom");
+    REQUIRE(bloom.width == bright.width);
+    const int radius = 4, taps = (radius + 1) / 2;  // the pass's defaults
+    const float intensity = 0.6f, sigma = std::max(0.5f, radius * 0.25f);
+    std::vector<float> w(taps + 1);
+    float total = 0.0f;
+    for (int i = 0; i <= taps; ++i) total += (i ? 2.0f : 1.0f) * (w[i] = std::exp(-float(i * i) / (2 * sigma * sigma)));
+    for (float& v : w) v /= total;
+    auto blur = [&](const FloatImage& in, int dx, int dy, float gain) {
+        FloatImage out = in;
+        for (int y = 0; y < in.height; ++y)
+            for (int x = 0; x < in.width; ++x)
+                for (int c = 0; c < 3; ++c) {
+                    float sum = w[0] * in.at(x, y)[c];
+                    for (int i = 1; i <= taps; ++i)
+                        sum += w[i] * (in.at(std::clamp(x + dx * i, 0, in.width - 1), std::clamp(y + dy * i, 0, in.height - 1))[c] +
+                                       in.at(std::clamp(x - dx * i, 0, in.width - 1), std::clamp(y - dy * i, 0, in.height - 1))[c]);
+                    out.at(x, y)[c] = gain * sum;
+                }
+        return out;
+    };
+    const FloatImage expected = blur(blur(bright, 1, 0, 1.0f), 0, 1, intensity);
+    int glowing = 0, wrong = 0, dark = 0;
+    for (int y = 0; y < bloom.height; ++y)
+        for (int x = 0; x < bloom.width; ++x)
+            for (int c = 0; c < 3; ++c) {
+                const float e = expected.at(x, y)[c], g = bloom.at(x, y)[c];
+                if (e == 0.0f) {
+                    ++dark;
+                    wrong += g != 0.0f;
+                } else {
+                    ++glowing;
+                    wrong += std::abs(g - e) > 2e-3f * std::max(1.0f, e);
+                }
+            }
+    INFO(glowing << " channels glow, " << dark << " are dark, " << wrong << " differ");
+    CHECK(glowing > 100);
+    CHECK(dark > glowing);  // the rectangle is not the whole picture
+    CHECK(wrong == 0);
+}
+
 TEST_CASE("sphere level of detail: the silhouette stays within a pixel of the circle up to a 200-px radius",
           "[scene]") {
     // Independent of the thresholds' own comment: the largest gap between an n-segment
