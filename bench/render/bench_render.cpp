@@ -374,7 +374,7 @@ int main(int argc, char** argv) {
             }
     }
     const double floorMs = median(floors);
-    std::printf("floor: an empty full-screen pass at %dx%d (its coordinates written to RGBA16F) takes %.2f ms (wall, glFinish)\n\n",
+    std::printf("floor: an empty full-screen pass at %dx%d (its coordinates written to RGBA16F) takes %.3f ms (wall, glFinish)\n\n",
                 args.width, args.height, floorMs);
     for (size_t i = 0; i < configs.size(); ++i) report(configs[i], measured[i], floorMs, csv);
     if (!args.growKind.empty()) reportGrowth(args, configs, measured);
