@@ -57,8 +57,13 @@
 //      add their albedo and normal (six more sums), resolved into `albedo` and
 //      `normal`: what voxel_mip needs to bounce the light the voxels hold.
 //
-// Cleared and rebuilt whenever it runs; the host skips it when neither the scene
-// (static geometry, bodies, particles, light) nor the shadow map changed.
+// Rebuilt whenever it runs, from the lamp dome's voxels up: those are built once into
+// `lamp_sums` (and again when the lamp, the scene's meshes, the resolution or the
+// program change) and copied in each frame in place of a clear — the dome never moves
+// and is lit without a shadow test (it is the emitter; nothing that moves reaches the
+// space between it and the shadow map's eye). 1 ms of the 8 at 720², moving. The host
+// skips the pass when neither the scene (static geometry, bodies, particles, light) nor
+// the shadow map changed.
 #include <kiln/pass.hpp>
 
 #include <algorithm>
@@ -97,6 +102,9 @@ public:
                     .doc = "the fixed-point accumulators (shaders/voxelize/sums.glsl): radiance rgb, fragment "
                            "count, albedo rgb, normal xyz, the particles' cover and (fire_cover on) the emitted part of the "
                            "radiance apart, fourteen grids side by side along x"});
+        d.internal({.name = "lamp_sums", .kind = TextureKind::Color3D, .format = Format::R32UI,
+                    .size = SizeRule::fromParam("resolution", 1.0f, kSumChannels),
+                    .doc = "the lamp dome's own sums, built when the lamp changes: each frame's sums start from them"});
         d.internal({.name = "lamp_field", .format = Format::RG16F, .size = SizeRule::fixed(kLampFieldSide, kLampFieldSide),
                     .doc = "lamp_model field: the lamp's vector irradiance over (distance from its axis, height)"});
         d.param(intChoiceParam("resolution", 64, {32, 64, 128}, "voxels per side over [-1,1]^3"))
@@ -170,7 +178,12 @@ public:
         const kiln::TextureRef& out = ctx.output("radiance");
         const int res = out.width;
 
-        glClearTexImage(ctx.internal("sums").id, 0, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
+        // The sums start from the lamp dome's (integer sums: the order of adding is free).
+        const kiln::TextureRef& sums = ctx.internal("sums");
+        const kiln::TextureRef& lampSums = ctx.internal("lamp_sums");
+        voxelizeLamp(ctx, raster, res, lampSums);
+        glCopyImageSubData(lampSums.id, GL_TEXTURE_3D, 0, 0, 0, 0, sums.id, GL_TEXTURE_3D, 0, 0, 0, 0, sums.width,
+                           sums.height, sums.depth);
 
         // The particles' cover and the transmittance grid from it: the resolve reads the grid.
         if (fireCover) coverFire(ctx, coverer, fireResolve, fireMip, fireLight, res);
@@ -181,10 +194,24 @@ public:
     }
 
 private:
-    // 1–3: the box, the tumblers and whatever is not splatted, rasterised into the sums
-    // (no attachments: the fragment shader only does atomics); then the lamp.
-    void rasterize(kiln::PassContext& ctx, GLuint raster, int res, bool rasterParticles, bool rasterFireballs,
-                   bool rasterTumblers) {
+    // The lamp dome alone into `lamp_sums`, when what it depends on changed.
+    void voxelizeLamp(kiln::PassContext& ctx, GLuint raster, int res, const kiln::TextureRef& lampSums) {
+        const kiln::SceneView& scene = ctx.scene();
+        const LampKey key{scene.version(kiln::kSceneLamp), scene.version(kiln::kSceneLight), lampSums.id, raster};
+        if (key == builtLamp_) return;
+        glClearTexImage(lampSums.id, 0, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
+        beginRaster(ctx, raster, res, lampSums.id);
+        glUniform1f(glGetUniformLocation(raster, "u_emissionScale"), ctx.getFloat("lamp_emission"));
+        glUniform1i(glGetUniformLocation(raster, "u_unshadowed"), 1);
+        ctx.drawScene({.categories = kiln::kSceneLamp, .lod = kiln::Lod::Low});
+        glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+        glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+        builtLamp_ = key;
+    }
+
+    // The raster state for adding meshes to sums `target`: the program in use with its
+    // inputs bound, an attachment-less framebuffer of the voxels' size.
+    void beginRaster(kiln::PassContext& ctx, GLuint raster, int res, GLuint target) {
         if (!fbo_) fbo_ = kiln::gl::createFramebuffer();
         if (fboSize_ != res) {
             glNamedFramebufferParameteri(fbo_.id(), GL_FRAMEBUFFER_DEFAULT_WIDTH, res);
@@ -197,7 +224,16 @@ private:
         glDisable(GL_CULL_FACE);
         glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
         useSurfaceProgram(ctx, raster, res);
+        kiln::gl::bindImage(raster, "u_sums", target, 0, true, GL_READ_WRITE, GL_R32UI);
         glUniform1f(glGetUniformLocation(raster, "u_conservative"), ctx.getBool("conservative") ? 1.0f : 0.0f);
+    }
+
+    // 1–3: the box, the tumblers and whatever is not splatted, rasterised into the sums
+    // (no attachments: the fragment shader only does atomics). The lamp is in them already.
+    void rasterize(kiln::PassContext& ctx, GLuint raster, int res, bool rasterParticles, bool rasterFireballs,
+                   bool rasterTumblers) {
+        beginRaster(ctx, raster, res, ctx.internal("sums").id);
+        glUniform1i(glGetUniformLocation(raster, "u_unshadowed"), 0);
         uint32_t cats = kiln::kSceneBox | (rasterTumblers ? kiln::kSceneTumblers : 0u);
         if (rasterParticles) cats |= kiln::kSceneParticles;
         if (ctx.getBool("marbles")) cats |= kiln::kSceneMarbles;
@@ -210,8 +246,6 @@ private:
             ctx.drawScene({.categories = kiln::kSceneFireballs, .lod = kiln::Lod::Low});
             glUniform1i(glGetUniformLocation(raster, "u_sphereFlux"), 0);
         }
-        glUniform1f(emissionScale, ctx.getFloat("lamp_emission"));
-        ctx.drawScene({.categories = kiln::kSceneLamp, .lod = kiln::Lod::Low});
         glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     }
 
@@ -357,6 +391,13 @@ private:
         bool operator==(const FieldKey&) const = default;
     };
     FieldKey builtField_;
+    // What `lamp_sums` was last built from (a cache: a reload or a parameter starts over).
+    struct LampKey {
+        uint64_t lampVersion = 0, lightVersion = 0;
+        GLuint texture = 0, program = 0;
+        bool operator==(const LampKey&) const = default;
+    };
+    LampKey builtLamp_;
 
     kiln::gl::FramebufferHandle fbo_;  // attachment-less; a GL cache only (a reload makes a new one)
     int fboSize_ = 0;

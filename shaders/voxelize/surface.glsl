@@ -12,11 +12,12 @@ layout(binding = 1) uniform sampler2D u_lampField;
 #endif
 uniform int u_res;          // voxels per side
 uniform float u_shadowBias;
+uniform bool u_unshadowed;  // the lamp dome (voxelize.cpp): the emitter, never in a shadow
 
 vec3 lampReflected(vec3 albedo, vec3 p, vec3 n) {
     float vis = 1.0;
 #if KILN_HAS_SHADOW_MAP
-    vis = shadowHard(u_shadowMap, p + n * (2.0 / float(u_res)), u_shadowBias);
+    vis = u_unshadowed ? 1.0 : shadowHard(u_shadowMap, p + n * (2.0 / float(u_res)), u_shadowBias);
 #endif
 #if KILN_LAMP_FIELD
     vec3 irradiance = u_lightColor.rgb * lampFieldSolidAngle(lampFieldAt(u_lampField, p), p, n);

@@ -161,6 +161,45 @@ TEST_CASE("voxelize: the five walls are solid one-voxel layers, the inside and t
     CHECK(vol.at(n / 2, 0, n / 2)[0] > 0.05f);
 }
 
+TEST_CASE("voxelize: the lamp dome's voxels, built once, stay what a fresh build gives, and a new lamp rebuilds them",
+          "[gi][voxelize]") {
+    // The dome is voxelized into `lamp_sums` when the lamp changes and copied into each
+    // frame's sums. One rig renders 20 frames of the shipped scene moving (built at the
+    // first); another steps the same simulation 20 times unrendered and renders once
+    // (built then): the voxels must be equal, exactly (integer sums). A cache that
+    // collected the dome again each frame, or kept a frame's bodies, would differ.
+    const std::string passes = R"(
+        {"id": "shadow", "module": "shadow", "params": {"size": 256}},
+        {"id": "voxelize", "module": "voxelize", "inputs": {"shadow_map": "shadow.depth"}, "params": {"resolution": 32}},
+        {"id": "voxel_view", "module": "voxel_view", "inputs": {"voxels": "voxelize.radiance"}})";
+    Rig moving({}, 32), fresh({}, 32);
+    moving.load(pipeline("voxel_view.color", passes));
+    fresh.load(pipeline("voxel_view.color", passes));
+    moving.app.paused = false;
+    for (int f = 0; f < 20; ++f) moving.app.frame();
+    for (int f = 0; f < 20; ++f) fresh.app.scene().step();
+    fresh.app.frame();
+    REQUIRE(moving.app.scene().time() == Approx(fresh.app.scene().time()));
+    moving.checkNoErrors();
+    for (const char* name : {"radiance", "albedo", "normal"}) {
+        const Volume a = read3d(moving.tex("voxelize", name), 0), b = read3d(fresh.tex("voxelize", name), 0);
+        size_t differ = 0;
+        for (size_t i = 0; i < a.v.size(); ++i) differ += a.v[i] != b.v[i];
+        INFO(name << ": " << differ << " values differ");
+        CHECK(differ == 0);
+    }
+    // A lamp of radius 0.5 (0.35 shipped) reaches down to y = 0.6 (voxel 25 under its
+    // centre): the rebuilt dome fills it.
+    const Volume before = read3d(moving.tex("voxelize", "radiance"), 0);
+    CHECK(before.at(16, 25, 16)[3] == 0.0f);
+    nlohmann::json scene = nlohmann::json::parse(std::ifstream(KILN_SOURCE_DIR "/scenes/cornell.json"));
+    scene["lamp"]["radius"] = 0.5;
+    std::string error;
+    REQUIRE(moving.app.scene().load(writeScene("big_lamp.json", scene.dump()), std::nullopt, error));
+    moving.app.frame();
+    CHECK(read3d(moving.tex("voxelize", "radiance"), 0).at(16, 25, 16)[3] == 1.0f);
+}
+
 TEST_CASE("voxelize: a tumbler's shell is closed — no 6-connected path from the room into it",
           "[gi][voxelize]") {
     // The low-poly tumbler (12 × 4 segments) at 32³: its sides are tilted, so only the
