@@ -58,12 +58,12 @@
 //      `normal`: what voxel_mip needs to bounce the light the voxels hold.
 //
 // Rebuilt whenever it runs, from the lamp dome's voxels up: those are built once into
-// `lamp_sums` (and again when the lamp, the scene's meshes, the resolution or the
-// program change) and copied in each frame in place of a clear — the dome never moves
-// and is lit without a shadow test (it is the emitter; nothing that moves reaches the
-// space between it and the shadow map's eye). 1 ms of the 8 at 720², moving. The host
-// skips the pass when neither the scene (static geometry, bodies, particles, light) nor
-// the shadow map changed.
+// `lamp_sums` (and again when the lamp, the scene's meshes, the resolution, the program
+// or the parameters the dome depends on change) and copied in each frame in place of a
+// clear — the dome never moves and is lit without a shadow test (it is the emitter;
+// nothing that moves reaches the space between it and the shadow map's eye). 1 ms of the
+// 8 at 720², moving. The host skips the pass when neither the scene (static geometry,
+// bodies, particles, light) nor the shadow map changed.
 #include <kiln/pass.hpp>
 
 #include <algorithm>
@@ -197,7 +197,10 @@ private:
     // The lamp dome alone into `lamp_sums`, when what it depends on changed.
     void voxelizeLamp(kiln::PassContext& ctx, GLuint raster, int res, const kiln::TextureRef& lampSums) {
         const kiln::SceneView& scene = ctx.scene();
-        const LampKey key{scene.version(kiln::kSceneLamp), scene.version(kiln::kSceneLight), lampSums.id, raster};
+        // The debug view edits a parameter on the same object: the two the dome's voxels
+        // depend on are in the key (lamp_model changes the program).
+        const LampKey key{scene.version(kiln::kSceneLamp), scene.version(kiln::kSceneLight), lampSums.id, raster, res,
+                          ctx.getFloat("lamp_emission"), ctx.getBool("conservative")};
         if (key == builtLamp_) return;
         glClearTexImage(lampSums.id, 0, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
         beginRaster(ctx, raster, res, lampSums.id);
@@ -391,10 +394,13 @@ private:
         bool operator==(const FieldKey&) const = default;
     };
     FieldKey builtField_;
-    // What `lamp_sums` was last built from (a cache: a reload or a parameter starts over).
+    // What `lamp_sums` was last built from (a cache: a module reload starts over).
     struct LampKey {
         uint64_t lampVersion = 0, lightVersion = 0;
         GLuint texture = 0, program = 0;
+        int resolution = 0;
+        float emission = -1.0f;
+        bool conservative = false;
         bool operator==(const LampKey&) const = default;
     };
     LampKey builtLamp_;

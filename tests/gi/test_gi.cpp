@@ -197,7 +197,13 @@ TEST_CASE("voxelize: the lamp dome's voxels, built once, stay what a fresh build
     std::string error;
     REQUIRE(moving.app.scene().load(writeScene("big_lamp.json", scene.dump()), std::nullopt, error));
     moving.app.frame();
-    CHECK(read3d(moving.tex("voxelize", "radiance"), 0).at(16, 25, 16)[3] == 1.0f);
+    const Volume bigLamp = read3d(moving.tex("voxelize", "radiance"), 0);
+    CHECK(bigLamp.at(16, 25, 16)[3] == 1.0f);
+    // A parameter edited in the debug view (the same pass object): the dome's emission
+    // into its voxels (0 shipped) rebuilds them.
+    REQUIRE(moving.app.runtime().setParam("voxelize", "lamp_emission", 1.0f, error));
+    moving.app.frame();
+    CHECK(read3d(moving.tex("voxelize", "radiance"), 0).at(16, 25, 16)[0] > bigLamp.at(16, 25, 16)[0] + 1.0f);
 }
 
 TEST_CASE("voxelize: a tumbler's shell is closed — no 6-connected path from the room into it",
