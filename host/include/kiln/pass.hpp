@@ -163,9 +163,11 @@
 //   Set every uniform in each execute(): a shader edit swaps in a new program and no
 //   uniform value is carried over (so nothing needs restoring by reflection).
 //   No state in statics (a reload loses it); no thread_local with destructors. State
-//   in members is a cache only: a module reload or a parameter change gives you a new
-//   object. Modules are built with -fvisibility=hidden -fno-gnu-unique by
-//   kiln_add_pass (cmake/KilnModule.cmake).
+//   in members is a cache only: a module reload or a pipeline reload that changes the
+//   pass gives you a new object, but a parameter edited in the debug view runs the same
+//   object again (Runtime::setParam), so key a cache on the parameters it was built
+//   from. Modules are built with -fvisibility=hidden -fno-gnu-unique by kiln_add_pass
+//   (cmake/KilnModule.cmake).
 #pragma once
 
 #include <algorithm>
