@@ -294,9 +294,11 @@ int main(int argc, char** argv) {
         situations.push_back({"moving, bloom disabled", editedPipeline(pipeline, false, true), o.scene, false});
         situations.push_back({"asleep (tumblers at rest, no balls)", pipeline, restingScene(o.scene, args.outDir, false), false, 1.0, true});
         const std::string oneMarble = restingScene(o.scene, args.outDir, true);
-        situations.push_back({"one marble moving, the rest asleep", pipeline, oneMarble, false, 1.0, false, false, 24});
-        situations.push_back({"one marble moving, the whole picture redrawn (--full-redraw)", pipeline, oneMarble,
-                              false, 1.0, false, true, 24});
+        situations.push_back({.label = "one marble moving, the rest asleep", .pipelineText = pipeline,
+                              .sceneFile = oneMarble, .restSeconds = 1.0, .warmFrames = 24});
+        situations.push_back({.label = "one marble moving, the whole picture redrawn (--full-redraw)",
+                              .pipelineText = pipeline, .sceneFile = oneMarble, .restSeconds = 1.0,
+                              .fullRedraw = true, .warmFrames = 24});
     }
     const std::vector<Outcome> outcomes = measureRounds(app, situations, args);
 

@@ -119,17 +119,15 @@ public:
         // rectangle to redraw).
         if (nearField) {
             const glm::vec4 lamp = ctx.scene().frame.lightPos;
-            const Rect r = screenRect(ctx, glm::vec3(lamp), lamp.w + ctx.getFloat("lamp_near_field"));
-            kiln::forEachRedrawRect(ctx, color.width, color.height, 0, [&] {
-                GLint box[4] = {0, 0, color.width, color.height};
-                if (glIsEnabled(GL_SCISSOR_TEST)) glGetIntegerv(GL_SCISSOR_BOX, box);
-                const int x0 = std::max(r.x, box[0]), x1 = std::min(r.x + r.width, box[0] + box[2]);
-                const int y0 = std::max(r.y, box[1]), y1 = std::min(r.y + r.height, box[1] + box[3]);
-                if (x1 <= x0 || y1 <= y0) return;
-                glEnable(GL_SCISSOR_TEST);
+            const kiln::PixelRect r = screenRect(ctx, glm::vec3(lamp), lamp.w + ctx.getFloat("lamp_near_field"));
+            glEnable(GL_SCISSOR_TEST);
+            for (const kiln::PixelRect& part : kiln::redrawRects(ctx, color.width, color.height, 0)) {
+                const int x0 = std::max(r.x, part.x), x1 = std::min(r.x + r.width, part.x + part.width);
+                const int y0 = std::max(r.y, part.y), y1 = std::min(r.y + r.height, part.y + part.height);
+                if (x1 <= x0 || y1 <= y0) continue;
                 glScissor(x0, y0, x1 - x0, y1 - y0);
                 draw(ctx, nearProgram);
-            });
+            }
             glDisable(GL_SCISSOR_TEST);
         }
         kiln::gl::bindSamplerObject(program, "u_shadowMap", 0);  // the host resets textures, not samplers
@@ -189,12 +187,9 @@ private:
     FieldKey builtField_;
     kiln::gl::Texture lampField_;
 
-    struct Rect {
-        int x = 0, y = 0, width = 0, height = 0;
-    };
     // The pixels a sphere can cover: its bounding box's corners projected; the whole
     // output when one is behind the camera.
-    static Rect screenRect(kiln::PassContext& ctx, glm::vec3 centre, float radius) {
+    static kiln::PixelRect screenRect(kiln::PassContext& ctx, glm::vec3 centre, float radius) {
         const int w = ctx.frame().outputWidth, h = ctx.frame().outputHeight;
         glm::vec2 lo(1.0f), hi(-1.0f);
         for (int i = 0; i < 8; ++i) {
