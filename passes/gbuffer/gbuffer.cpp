@@ -26,12 +26,15 @@ public:
     }
 
     void execute(kiln::PassContext& ctx) override {
-        GLuint program = ctx.program({.stages = {"gbuffer/gbuffer.vert", "gbuffer/gbuffer.frag"}});
+        // One program per material (gbuffer.vert): the floor's grain is a lookup that the
+        // rest of the picture must not pay for.
+        GLuint program = ctx.program({.stages = {"gbuffer/gbuffer.vert", "gbuffer/gbuffer.frag"}, .defines = {{"KILN_WOOD", "0"}}});
+        GLuint woodProgram = ctx.program({.stages = {"gbuffer/gbuffer.vert", "gbuffer/gbuffer.frag"}, .defines = {{"KILN_WOOD", "1"}}});
         const bool particles = ctx.getBool("particles");
         const bool points = particles && ctx.getEnum("particle_mode") == "points";
         GLuint pointProgram = points ? ctx.program({.stages = {"gbuffer/particle.vert", "gbuffer/particle.frag"}}) : 0;
         GLuint bake = ctx.program({.stages = {"gbuffer/wood.comp"}});
-        if (!program || !bake || (points && !pointProgram)) return;
+        if (!program || !woodProgram || !bake || (points && !pointProgram)) return;
         // The floor's grain, baked: sampled through its mips it is the grain averaged
         // over each pixel, as the reference sees it (at 256²: floor relMSE 0.058
         // against 0.075 evaluated at pixel centres, SSIM 0.789 against 0.772), for
@@ -57,7 +60,6 @@ public:
             glEnable(GL_DEPTH_TEST);
             glDepthFunc(GL_LESS);
             glUseProgram(program);
-            kiln::gl::bindTexture(program, "u_wood", wood.id);
             kiln::DrawFilter filter;
             filter.categories = kiln::kSceneGeometry;
             if (!particles || points) filter.categories &= ~kiln::kSceneParticles;
@@ -71,6 +73,10 @@ public:
             glCullFace(GL_BACK);
             ctx.drawScene({.categories = kiln::kSceneBodies});
             glDisable(GL_CULL_FACE);
+            // The floor, the one wood-grained instance (a wall of the box).
+            glUseProgram(woodProgram);
+            kiln::gl::bindTexture(woodProgram, "u_wood", wood.id);
+            ctx.drawScene({.categories = kiln::kSceneBox});
 
             // Thousands of particles a few pixels wide: one point each, not 8 triangles
             // (4 000 octahedra cost the G-buffer 15 ms at 720² on llvmpipe).

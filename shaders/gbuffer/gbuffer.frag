@@ -6,7 +6,7 @@ layout(binding = 1) uniform sampler2D u_wood;  // the floor's grain over x, z in
 
 in vec3 v_world;
 in vec3 v_normal;
-flat in vec4 v_albedo;    // rgb, a = material (0 plain, 1 wood grain)
+flat in vec4 v_albedo;    // rgb, a = material (0 plain, 1 wood grain: drawn with KILN_WOOD 1, gbuffer.vert)
 flat in vec4 v_emissive;  // rgb radiance, a = highlight
 
 layout(location = 0) out vec4 o_albedo;
@@ -14,8 +14,11 @@ layout(location = 1) out vec4 o_normal;    // xyz world-space unit normal, w = 1
 layout(location = 2) out vec4 o_emissive;  // rgb radiance
 
 void main() {
+#if KILN_WOOD
+    vec3 albedo = texture(u_wood, v_world.xz * 0.5 + 0.5).rgb;
+#else
     vec3 albedo = v_albedo.rgb;
-    if (v_albedo.a > 0.5) albedo = texture(u_wood, v_world.xz * 0.5 + 0.5).rgb;
+#endif
     vec3 n = normalize(v_normal);
     if (!gl_FrontFacing) n = -n;
     vec3 emissive = v_emissive.rgb;

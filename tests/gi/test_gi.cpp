@@ -750,12 +750,16 @@ TEST_CASE("gbuffer: particles drawn as points cover what their meshes cover, whe
 TEST_CASE("gbuffer: the baked floor grain follows the scene's wood colours, re-baked on reload", "[gi][gbuffer]") {
     // Light and dark wood set to one colour: every floor pixel's albedo is that colour
     // whatever the grain (RGBA8: within 1/255 plus rounding). Reloading the scene with
-    // another colour must re-bake: the albedo follows.
+    // another colour must re-bake: the albedo follows. The floor and the other walls are
+    // drawn by two programs (gbuffer.vert): the side walls keep their own colours.
     const char* scenes[2] = {
         R"({"tumblers": [], "marbles": [], "fireballs": [],
-            "box": {"floor_wood": {"light": [0.2, 0.4, 0.6], "dark": [0.2, 0.4, 0.6], "ring_frequency": 14}}})",
+            "box": {"left": [0.9, 0.5, 0.1], "right": [0.3, 0.6, 0.9],
+                    "floor_wood": {"light": [0.2, 0.4, 0.6], "dark": [0.2, 0.4, 0.6], "ring_frequency": 14}}})",
         R"({"tumblers": [], "marbles": [], "fireballs": [],
-            "box": {"floor_wood": {"light": [0.7, 0.1, 0.3], "dark": [0.7, 0.1, 0.3], "ring_frequency": 14}}})"};
+            "box": {"left": [0.9, 0.5, 0.1], "right": [0.3, 0.6, 0.9],
+                    "floor_wood": {"light": [0.7, 0.1, 0.3], "dark": [0.7, 0.1, 0.3], "ring_frequency": 14}}})"};
+    const glm::vec3 sideColour[2] = {{0.9f, 0.5f, 0.1f}, {0.3f, 0.6f, 0.9f}};  // x = -1, x = +1
     const glm::vec3 expected[2] = {{0.2f, 0.4f, 0.6f}, {0.7f, 0.1f, 0.3f}};
     Rig rig(writeScene("wood_a.json", scenes[0]), 96);
     rig.load(pipeline("gbuffer.albedo", R"({"id": "gbuffer", "module": "gbuffer"})"), {"gbuffer.depth"});
@@ -768,20 +772,29 @@ TEST_CASE("gbuffer: the baked floor grain follows the scene's wood colours, re-b
         rig.app.frame();
         rig.checkNoErrors();
         const FloatImage albedo = rig.image("gbuffer", "albedo"), depth = rig.image("gbuffer", "depth");
-        int floorPixels = 0;
-        float worst = 0;
+        int floorPixels = 0, sidePixels = 0;
+        float worst = 0, worstSide = 0;
         for (int y = 0; y < 96; ++y)
             for (int x = 0; x < 96; ++x) {
                 if (depth.at(x, y)[0] >= 1.0f) continue;
-                // The floor (y = −1), away from the walls' bottom edges.
                 const glm::vec3 w = worldOf(rig, depth, x, y);
+                // A side wall (x = ±1), away from its edges.
+                if (std::abs(std::abs(w.x) - 1.0f) < 0.01f && std::abs(w.y) < 0.95f && std::abs(w.z) < 0.95f) {
+                    ++sidePixels;
+                    for (int c = 0; c < 3; ++c)
+                        worstSide = std::max(worstSide, std::abs(albedo.at(x, y)[c] - sideColour[w.x > 0][c]));
+                }
+                // The floor (y = −1), away from the walls' bottom edges.
                 if (std::abs(w.y + 1.0f) > 0.01f || std::abs(w.x) > 0.95f || std::abs(w.z) > 0.95f) continue;
                 ++floorPixels;
                 for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(albedo.at(x, y)[c] - expected[round][c]));
             }
-        INFO("round " << round << ": " << floorPixels << " floor pixels, worst channel error " << worst);
+        INFO("round " << round << ": " << floorPixels << " floor pixels, worst channel error " << worst << "; "
+                      << sidePixels << " side-wall pixels, worst " << worstSide);
         CHECK(floorPixels > 500);
         CHECK(worst <= 2.0f / 255.0f);
+        CHECK(sidePixels > 500);
+        CHECK(worstSide <= 2.0f / 255.0f);
     }
 }
 
