@@ -10,6 +10,9 @@
 #include "common/wood.glsl"
 #include "sums.glsl"
 #include "surface.glsl"
+#if KILN_RECORD_STATIC
+#include "static_surfaces.glsl"
+#endif
 
 in vec3 v_world;
 in vec3 v_normal;
@@ -39,7 +42,6 @@ void main() {
     vec3 n = normalize(v_normal);
     float scale = u_emissionScale;
     if (u_sphereFlux) scale *= sphereFluxScale(kilnSphereRadius(inst));
-    uvec3 lit = toFixedRadiance(lampReflected(albedo, v_world, n));
     uvec3 emitted = toFixedRadiance(inst.emissive.rgb * scale);
 
     float zLo = clamp(depth - span, v_depthRange.x, v_depthRange.y);
@@ -47,6 +49,19 @@ void main() {
     int k0 = clamp(int(floor((zLo * 0.5 + 0.5) * float(u_res))), 0, u_res - 1);
     int k1 = clamp(int(floor((zHi * 0.5 + 0.5) * float(u_res))), 0, u_res - 1);
     ivec2 ij = clamp(ivec2(px), ivec2(0), ivec2(u_res - 1));
+#if KILN_RECORD_STATIC
+    // A static surface: everything but its lamp light now, the fragment kept for
+    // static_light.comp to light each frame.
+    uvec3 lit = uvec3(0u);
+    uint slot = atomicAdd(u_recorded, 1u);
+    if (slot < u_capacity) {
+        ivec3 first = v_axis == 0 ? ivec3(k0, ij.x, ij.y) : v_axis == 1 ? ivec3(ij.y, k0, ij.x) : ivec3(ij, k0);
+        int voxels = min(k1, k0 + 2) - k0 + 1;
+        u_fragments[slot] = StaticFragment(vec4(v_world, 0.0), vec4(n, 0.0), vec4(albedo, 0.0), ivec4(first, v_axis | voxels << 2));
+    }
+#else
+    uvec3 lit = toFixedRadiance(lampReflected(albedo, v_world, n));
+#endif
     for (int k = k0; k <= min(k1, k0 + 2); ++k) {
         // Back from (2D, depth) to (x, y, z): the inverse of the geometry shader's swizzle.
         addSurfaceToVoxel(v_axis == 0 ? ivec3(k, ij.x, ij.y) : v_axis == 1 ? ivec3(ij.y, k, ij.x) : ivec3(ij, k), lit,

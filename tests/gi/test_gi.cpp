@@ -163,7 +163,7 @@ TEST_CASE("voxelize: the five walls are solid one-voxel layers, the inside and t
 
 TEST_CASE("voxelize: the lamp dome's voxels, built once, stay what a fresh build gives, and a new lamp rebuilds them",
           "[gi][voxelize]") {
-    // The dome is voxelized into `lamp_sums` when the lamp changes and copied into each
+    // The dome is voxelized into `static_sums` when the lamp changes and copied into each
     // frame's sums. One rig renders 20 frames of the shipped scene moving (built at the
     // first); another steps the same simulation 20 times unrendered and renders once
     // (built then): the voxels must be equal, exactly (integer sums). A cache that
@@ -204,6 +204,56 @@ TEST_CASE("voxelize: the lamp dome's voxels, built once, stay what a fresh build
     REQUIRE(moving.app.runtime().setParam("voxelize", "lamp_emission", 1.0f, error));
     moving.app.frame();
     CHECK(read3d(moving.tex("voxelize", "radiance"), 0).at(16, 25, 16)[0] > bigLamp.at(16, 25, 16)[0] + 1.0f);
+}
+
+TEST_CASE("voxelize: the kept walls, lit again each frame, give the voxels every surface rasterized each frame gives",
+          "[gi][voxelize]") {
+    // keep_static rasterizes the walls once and each frame lights their recorded
+    // fragments by the frame's shadow map (voxelize/static_light.comp). Against a rig that
+    // rasterizes everything every frame (keep_static off), 20 frames of the shipped scene
+    // moving (the tumblers' shadows move over the walls and the floor): the volumes must
+    // be equal exactly — the same function of the same point, normal and albedo, added to
+    // integer sums. Then a new scene file (other walls, another floor) rebuilds the kept
+    // walls: equal again.
+    auto passes = [](bool keep) {
+        return std::string(R"(
+        {"id": "shadow", "module": "shadow", "params": {"size": 256}},
+        {"id": "voxelize", "module": "voxelize", "inputs": {"shadow_map": "shadow.depth"},
+         "params": {"resolution": 32, "lamp_model": "field", "keep_static": )") +
+               (keep ? "true" : "false") + R"(}},
+        {"id": "voxel_view", "module": "voxel_view", "inputs": {"voxels": "voxelize.radiance"}})";
+    };
+    Rig kept({}, 32), whole({}, 32);
+    kept.load(pipeline("voxel_view.color", passes(true)));
+    whole.load(pipeline("voxel_view.color", passes(false)));
+    auto compare = [&](const char* when) {
+        for (const char* name : {"radiance", "albedo", "normal"}) {
+            const Volume a = read3d(kept.tex("voxelize", name), 0), b = read3d(whole.tex("voxelize", name), 0);
+            size_t differ = 0, lit = 0;
+            for (size_t i = 0; i < a.v.size(); ++i) differ += a.v[i] != b.v[i], lit += b.v[i] != 0.0f;
+            INFO(when << ", " << name << ": " << differ << " of " << lit << " nonzero values differ");
+            CHECK(lit > 1000);
+            CHECK(differ == 0);
+        }
+    };
+    for (Rig* rig : {&kept, &whole}) {
+        rig->app.paused = false;
+        for (int f = 0; f < 20; ++f) rig->app.frame();
+        rig->checkNoErrors();
+    }
+    compare("after 20 moving frames");
+    nlohmann::json scene = nlohmann::json::parse(std::ifstream(KILN_SOURCE_DIR "/scenes/cornell.json"));
+    scene["box"]["left"] = {0.2, 0.9, 0.2};
+    scene["box"]["floor_wood"]["light"] = {0.9, 0.9, 0.2};
+    const std::string file = writeScene("other_walls.json", scene.dump());
+    for (Rig* rig : {&kept, &whole}) {
+        std::string error;
+        INFO(error);
+        REQUIRE(rig->app.scene().load(file, std::nullopt, error));
+        rig->app.frame();
+        rig->checkNoErrors();
+    }
+    compare("after a new scene");
 }
 
 TEST_CASE("voxelize: a tumbler's shell is closed — no 6-connected path from the room into it",
