@@ -96,6 +96,21 @@ void TextureViewer::draw(const TextureRef& t, float depthNear, float depthFar, c
     const bool linear = depthPlanesApply(t, depthNear, depthFar, s);
     const bool plain = !is3D && !isUint && s.channel == 0 && !s.tonemap && !s.checker && legendPx == 0 && !linear &&
                        mip == 0;
+    // An 8-bit image shown texel for texel (the window's main image at --size): copied.
+    // What the plain shader would write (in [0, 1], no NaN), for half the cost on
+    // llvmpipe (a draw 3.1 ms at 720², the blit 1.7).
+    const bool unorm8 = t.format == GL_RGBA8 || t.format == GL_SRGB8_ALPHA8;
+    if (plain && unorm8 && s.rangeMin == 0.0f && s.rangeMax == 1.0f && plane == glm::ivec2(rect.z, rect.w) &&
+        effectiveZoom(s, canvas, plane) == 1.0f && effectiveCenter(s, plane) == glm::vec2(plane) * 0.5f) {
+        if (!blitSource_) blitSource_ = gl::createFramebuffer();
+        GLint target = 0;  // where draw() would have drawn
+        glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &target);
+        glNamedFramebufferTexture(blitSource_.id(), GL_COLOR_ATTACHMENT0, t.id, 0);
+        glBlitNamedFramebuffer(blitSource_.id(), GLuint(target), 0, 0, plane.x, plane.y, rect.x, rect.y, rect.x + rect.z,
+                               rect.y + rect.w, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+        glNamedFramebufferTexture(blitSource_.id(), GL_COLOR_ATTACHMENT0, 0, 0);
+        return;
+    }
     const GLuint p = plain ? plainProgram_.id() : program_.id();
     glUseProgram(p);
     glBindTextureUnit((isUint ? 2 : 0) + (is3D ? 1 : 0), t.id);

@@ -104,6 +104,7 @@ private:
     gl::ProgramHandle program_;
     gl::ProgramHandle plainProgram_;  // KILN_DISPLAY_PLAIN: a float 2D texture as it is
     gl::VertexArrayHandle vao_;
+    mutable gl::FramebufferHandle blitSource_;  // the shown texture, attached while it is copied
     gl::Texture canvas_;           // the ImGui window's image, redrawn every frame
     gl::FramebufferHandle canvasFbo_;
     std::map<std::string, ViewSettings> settings_;

@@ -178,6 +178,31 @@ TEST_CASE("the window's plain image display draws what the general texture viewe
     INFO(first.x << " " << first.y << " " << first.z);
     CHECK(glm::all(glm::lessThanEqual(glm::abs(first - glm::ivec3(0, 77, 153)), glm::ivec3(1))));
     CHECK(at(12 + 2 * 6, 4 + 2 * 2) == glm::ivec3(255));  // texel (6, 2): 1.1, 1.4, 1.7, clamped
+
+    // An 8-bit texture shown texel for texel (the window's main image) is copied, not
+    // drawn: the same pixels as the general shader's, at the rectangle's place only.
+    gl::Texture image = gl::Texture::create(GL_TEXTURE_2D, GL_RGBA8, 16, 12, 1, 1, "test.viewer.rgba8");
+    std::vector<uint8_t> bytes(16 * 12 * 4);
+    for (size_t i = 0; i < bytes.size(); ++i) bytes[i] = uint8_t((i * 37) % 256);
+    for (size_t i = 3; i < bytes.size(); i += 4) bytes[i] = 255;
+    glTextureSubImage2D(image.id(), 0, 0, 0, 16, 12, GL_RGBA, GL_UNSIGNED_BYTE, bytes.data());
+    const TextureRef imageRef{image.id(), GL_TEXTURE_2D, GL_RGBA8, 16, 12, 1, 1, true};
+    auto shown = [&](const app::ViewSettings& s) {
+        glBindFramebuffer(GL_FRAMEBUFFER, fbo.id());
+        const float grey[4] = {0.5f, 0.5f, 0.5f, 1.0f};
+        glClearBufferfv(GL_COLOR, 0, grey);
+        viewer.draw(imageRef, 0.0f, 0.0f, s, glm::ivec4(5, 7, 16, 12));
+        std::vector<uint8_t> out(size_t(kCanvasW * kCanvasH * 4));
+        glReadPixels(0, 0, kCanvasW, kCanvasH, GL_RGBA, GL_UNSIGNED_BYTE, out.data());
+        glBindFramebuffer(GL_FRAMEBUFFER, 0);
+        return out;
+    };
+    app::ViewSettings asItIs, checkered;
+    checkered.checker = true;
+    const std::vector<uint8_t> copied = shown(asItIs), drawnGeneral = shown(checkered);
+    CHECK(copied == drawnGeneral);
+    CHECK(copied[size_t(((7 + 2) * kCanvasW + 5 + 3) * 4)] == bytes[size_t((2 * 16 + 3) * 4)]);  // texel (3, 2)
+    CHECK(copied[0] == 128);  // outside the rectangle: untouched
 }
 
 TEST_CASE("the ray through a tumbler's projected centre picks that tumbler", "[scene][gl]") {
