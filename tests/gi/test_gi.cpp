@@ -848,6 +848,45 @@ TEST_CASE("gbuffer: the baked floor grain follows the scene's wood colours, re-b
     }
 }
 
+TEST_CASE("gbuffer: where no geometry is, every target holds zero, also where geometry was a frame before",
+          "[gi][gbuffer]") {
+    // The colours are not cleared: the background is drawn behind everything last
+    // (gbuffer.cpp). Frame 1 from inside the box (every pixel a wall), frame 2 from far
+    // outside it: the pixels around the box must read zero in albedo, normal (w = 0: no
+    // surface) and emission, and depth 1 — not the walls frame 1 left there.
+    Rig rig({}, 64);
+    rig.load(pipeline("gbuffer.albedo", R"({"id": "gbuffer", "module": "gbuffer"})"),
+             {"gbuffer.normal", "gbuffer.emissive", "gbuffer.depth"});
+    rig.app.camera().distance = 0.5f;
+    rig.app.frame();
+    rig.checkNoErrors();
+    int wallsFirst = 0;
+    const FloatImage firstNormal = rig.image("gbuffer", "normal");
+    for (int y = 0; y < 64; ++y)
+        for (int x = 0; x < 64; ++x) wallsFirst += firstNormal.at(x, y)[3] == 1.0f;
+    REQUIRE(wallsFirst == 64 * 64);
+    rig.app.camera().distance = 12.0f;
+    rig.app.frame();
+    rig.checkNoErrors();
+    const FloatImage albedo = rig.image("gbuffer", "albedo"), normal = rig.image("gbuffer", "normal"),
+                     emissive = rig.image("gbuffer", "emissive"), depth = rig.image("gbuffer", "depth");
+    int empty = 0, covered = 0, wrong = 0;
+    for (int y = 0; y < 64; ++y)
+        for (int x = 0; x < 64; ++x) {
+            if (depth.at(x, y)[0] < 1.0f) {
+                covered += normal.at(x, y)[3] == 1.0f;
+                continue;
+            }
+            ++empty;
+            for (int c = 0; c < 4; ++c)
+                wrong += albedo.at(x, y)[c] != 0.0f || normal.at(x, y)[c] != 0.0f || emissive.at(x, y)[c] != 0.0f;
+        }
+    INFO(empty << " empty pixels, " << covered << " covered, " << wrong << " empty-pixel channels not zero");
+    CHECK(empty > 1000);
+    CHECK(covered > 200);
+    CHECK(wrong == 0);
+}
+
 TEST_CASE("voxel_mip: every level of a constant volume equals it (iso and all six directions)", "[gi][mip]") {
     // Tolerance 2e-3: RGBA16F stores 0.6 with a spacing of 2^-11·0.6 ≈ 3e-4, and an
     // average of equal values (or a composite over an opaque front) is that value.
