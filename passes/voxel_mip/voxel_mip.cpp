@@ -163,9 +163,16 @@ public:
 
     void execute(kiln::PassContext& ctx) override {
         GLuint iso = ctx.program({.stages = {"voxel_mip/iso.comp"}});
-        GLuint aniso = ctx.program({.stages = {"voxel_mip/aniso.comp"}});
+        // aniso.comp: its first level from the base (with the facing rule), the rest each
+        // from the one before.
+        const std::string& facingMode = ctx.getEnum("facing");
+        const char* facing = facingMode == "back" ? "1" : facingMode == "back_and_edge" ? "2" : "0";
+        const AnisoPrograms aniso{
+            ctx.program({.stages = {"voxel_mip/aniso.comp"},
+                         .defines = {{"KILN_ANISO_FROM_BASE", "1"}, {"KILN_ANISO_FACING", facing}}}),
+            ctx.program({.stages = {"voxel_mip/aniso.comp"}, .defines = {{"KILN_ANISO_FROM_BASE", "0"}}})};
         GLuint blend = ctx.program({.stages = {"voxel_mip/fixed_cones.comp"}});
-        if (!iso || !aniso || !blend) return;
+        if (!iso || !aniso.fromBase || !aniso.fromLevel || !blend) return;
         const kiln::TextureRef& in = ctx.input("radiance");
         const kiln::TextureRef& chain = ctx.output("iso");
         const int bounces = ctx.getInt("bounces");
@@ -269,14 +276,16 @@ private:
     }
 
     // Every chain the mode builds, from iso's level 0.
-    void buildChains(kiln::PassContext& ctx, GLuint iso, GLuint aniso, GLuint blend) {
+    struct AnisoPrograms {
+        GLuint fromBase = 0, fromLevel = 0;
+    };
+    void buildChains(kiln::PassContext& ctx, GLuint iso, const AnisoPrograms& anisoPrograms, GLuint blend) {
         const kiln::TextureRef& chain = ctx.output("iso");
         const kiln::TextureRef& atlas = ctx.output("aniso");
         const kiln::TextureRef& fixed = ctx.output("fixed_cones");
         const std::string& mode = ctx.getEnum("mode");
         const int res = chain.width;
-        const std::string& facingMode = ctx.getEnum("facing");
-        const int facing = facingMode == "back" ? 1 : facingMode == "back_and_edge" ? 2 : 0;
+        const bool facing = ctx.getEnum("facing") != "off";
         glUseProgram(iso);
         for (int level = 1; level < chain.levels; ++level) {
             const int n = std::max(1, res >> level);
@@ -287,19 +296,18 @@ private:
         }
 
         if (mode != "iso") {
-            glUseProgram(aniso);
             // Directional level L (1 … log2 res) lives in atlas level L−1, octant side res>>L.
             for (int L = 1; (res >> L) >= 1; ++L) {
                 const int n = res >> L;
+                const GLuint aniso = L == 1 ? anisoPrograms.fromBase : anisoPrograms.fromLevel;
+                glUseProgram(aniso);
                 glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
                 if (L == 1)
                     kiln::gl::bindImage(aniso, "u_src", chain.id, 0, true, GL_READ_ONLY, GL_RGBA16F);
                 else
                     kiln::gl::bindImage(aniso, "u_src", atlas.id, L - 2, true, GL_READ_ONLY, GL_RGBA16F);
                 kiln::gl::bindImage(aniso, "u_dst", atlas.id, L - 1, true, GL_WRITE_ONLY, GL_RGBA16F);
-                glUniform1i(glGetUniformLocation(aniso, "u_fromBase"), L == 1 ? 1 : 0);
-                glUniform1i(glGetUniformLocation(aniso, "u_facing"), facing);
-                if (facing) kiln::gl::bindTexture(aniso, "u_normal", ctx.input("normal").id);
+                if (facing && L == 1) kiln::gl::bindTexture(aniso, "u_normal", ctx.input("normal").id);
                 glUniform1i(glGetUniformLocation(aniso, "u_size"), n);
                 glDispatchCompute(groups(n), groups(n), groups(n));
             }

@@ -10,9 +10,18 @@ layout(rgba16f, binding = 1) uniform writeonly image3D u_dst;  // atlas level (o
 
 layout(binding = 2) uniform sampler3D u_normal;                // voxelize.normal (u_facing only)
 
-uniform int u_fromBase;  // 1: the source is the isotropic base (the same for every direction)
+// KILN_ANISO_FROM_BASE 1: the source is the isotropic base (the same for every
+// direction), 0: the previous atlas level. KILN_ANISO_FACING (from the base only) 0: off;
+// 1: back faces empty; 2: back faces and edge-on empty. Defines, not uniforms: llvmpipe
+// runs every side of a branch, and the three ways of building a level (8, 8 + 8 and 48
+// loads) all ran for every voxel.
+#ifndef KILN_ANISO_FROM_BASE
+#define KILN_ANISO_FROM_BASE 0
+#endif
+#ifndef KILN_ANISO_FACING
+#define KILN_ANISO_FACING 0
+#endif
 uniform int u_size;      // parent voxels per side at this level
-uniform int u_facing;    // 0: off; 1: back faces empty; 2: back faces and edge-on empty (from the base only)
 
 ivec3 octant(int i) { return ivec3(i & 1, (i >> 1) & 1, i >> 2); }
 
@@ -54,15 +63,19 @@ const vec3 kDirection[6] = vec3[](vec3(1, 0, 0), vec3(-1, 0, 0), vec3(0, 1, 0), 
 vec4 facing(vec4 c, vec3 m, vec3 d) {
     float f = min(length(m), 1.0);
     if (f < 1e-3) return c;
-    float front = u_facing == 2 ? 1.0 - step(-0.05 * f, dot(m, d))  // edge-on emptied too
-                                : step(dot(m, d), 0.0);            // edge-on (m·d = 0) kept
+#if KILN_ANISO_FACING == 2
+    float front = 1.0 - step(-0.05 * f, dot(m, d));  // edge-on emptied too
+#else
+    float front = step(dot(m, d), 0.0);  // edge-on (m·d = 0) kept
+#endif
     return c * ((1.0 - f) + f * front);
 }
 
 void main() {
     ivec3 v = ivec3(gl_GlobalInvocationID);
     if (any(greaterThanEqual(v, ivec3(u_size)))) return;
-    if (u_fromBase == 1 && u_facing > 0) {
+#if KILN_ANISO_FROM_BASE && KILN_ANISO_FACING > 0
+    {
         ivec3 b = 2 * v;
         LOAD8(u_src, b);
         vec3 m000 = texelFetch(u_normal, b, 0).xyz, m100 = texelFetch(u_normal, b + ivec3(1, 0, 0), 0).xyz,
@@ -75,13 +88,14 @@ void main() {
                      facing(c110, m110, d), facing(c001, m001, d), facing(c101, m101, d), facing(c011, m011, d),
                      facing(c111, m111, d));
         }
-    } else if (u_fromBase == 1) {
-        LOAD8(u_src, 2 * v);
-        storeAll(v, 0, 5, c000, c100, c010, c110, c001, c101, c011, c111);
-    } else {
-        for (int i = 0; i < 6; ++i) {
-            LOAD8(u_src, 2 * v + octant(i) * (2 * u_size));
-            storeAll(v, i, i, c000, c100, c010, c110, c001, c101, c011, c111);
-        }
     }
+#elif KILN_ANISO_FROM_BASE
+    LOAD8(u_src, 2 * v);
+    storeAll(v, 0, 5, c000, c100, c010, c110, c001, c101, c011, c111);
+#else
+    for (int i = 0; i < 6; ++i) {
+        LOAD8(u_src, 2 * v + octant(i) * (2 * u_size));
+        storeAll(v, i, i, c000, c100, c010, c110, c001, c101, c011, c111);
+    }
+#endif
 }
