@@ -1,6 +1,7 @@
 #include "run/program_cache.hpp"
 
 #include <algorithm>
+#include <set>
 
 #include "kiln/log.hpp"
 
@@ -68,6 +69,8 @@ void ProgramCache::evictLeastRecentlyUsed() {
 
 int ProgramCache::reload(const ShaderLibrary& shaders, const std::vector<std::filesystem::path>& changed) {
     int rebuilt = 0;
+    // Variants of one shader (the same files, other defines) fail alike: each error once.
+    std::set<std::string> logged;
     for (auto& [key, entry] : entries_) {
         const bool affected = std::any_of(entry.dependencies.begin(), entry.dependencies.end(), [&](auto& dep) {
             return std::find(changed.begin(), changed.end(), dep) != changed.end();
@@ -84,7 +87,7 @@ int ProgramCache::reload(const ShaderLibrary& shaders, const std::vector<std::fi
             ++rebuilt;
         } else {
             entry.error = errorOf(build);
-            log::error(entry.error);
+            if (logged.insert(entry.error).second) log::error(entry.error);
         }
     }
     return rebuilt;
@@ -93,7 +96,8 @@ int ProgramCache::reload(const ShaderLibrary& shaders, const std::vector<std::fi
 std::vector<std::string> ProgramCache::standingErrors() const {
     std::vector<std::string> errors;
     for (auto& [key, entry] : entries_)
-        if (!entry.error.empty() && entry.program) errors.push_back(entry.error);
+        if (!entry.error.empty() && entry.program && std::find(errors.begin(), errors.end(), entry.error) == errors.end())
+            errors.push_back(entry.error);
     return errors;
 }
 

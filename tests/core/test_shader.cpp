@@ -214,6 +214,37 @@ TEST_CASE("program cache: bounded, least recently used goes, an evicted variant 
     CHECK(cache.generation() == generation + 1);  // cached now
 }
 
+TEST_CASE("program cache: a shader edit that breaks two variants stands as one error, the last good programs kept",
+          "[shader][gl]") {
+    // gbuffer builds its shader twice (KILN_WOOD 0 and 1): one typo must read as one
+    // error in the debug view, not one per variant.
+    REQUIRE(test::ensureHeadlessContext());
+    const fs::path root = fs::temp_directory_path() / ("kiln-variants-" + std::to_string(::getpid()));
+    fs::create_directories(root);
+    const fs::path file = root / "two.frag";
+    auto write = [&](const char* body) {
+        std::ofstream(file) << "#version 450 core\nout vec4 o;\nvoid main() {\n    o = vec4(float(VARIANT));\n" << body
+                            << "}\n";
+    };
+    write("");
+    const ShaderLibrary lib({root});
+    run::ProgramCache cache;
+    std::string error;
+    const GLuint a = cache.get(lib, {.stages = {"two.frag"}, .defines = {{"VARIANT", "0"}}}, error);
+    const GLuint b = cache.get(lib, {.stages = {"two.frag"}, .defines = {{"VARIANT", "1"}}}, error);
+    REQUIRE(a != 0);
+    REQUIRE(b != 0);
+    REQUIRE(a != b);
+    write("    o = mux(o);\n");
+    CHECK(cache.reload(lib, {fs::canonical(file)}) == 0);
+    const std::vector<std::string> standing = cache.standingErrors();
+    REQUIRE(standing.size() == 1);
+    CHECK(standing[0].find("two.frag:5") != std::string::npos);
+    CHECK(cache.get(lib, {.stages = {"two.frag"}, .defines = {{"VARIANT", "0"}}}, error) == a);  // kept
+    CHECK(cache.get(lib, {.stages = {"two.frag"}, .defines = {{"VARIANT", "1"}}}, error) == b);
+    fs::remove_all(root);
+}
+
 TEST_CASE("shader lines of any length are parsed without recursion (regression: std::regex overflowed the stack)",
           "[shader][robust]") {
     const fs::path root = fs::temp_directory_path() / ("kiln-long-lines-" + std::to_string(::getpid()));
