@@ -1,8 +1,9 @@
 #version 450 core
 // voxelize, keep_static: the lamp light of the static surfaces' recorded fragments
 // (static_surfaces.glsl), one invocation each, lit as voxelize.frag lights a fragment
-// (surface.glsl: the same function of the same point, normal and albedo, so the sums
-// are those the raster would add) and added to the voxels of its depth span.
+// (surface.glsl: the same formula from the same irradiance, kept when the fragment was
+// recorded, and this frame's shadow test of the same point, so the sums are those the
+// raster would add) and added to the voxels of its depth span.
 #include "common/frame.glsl"
 #include "common/light.glsl"
 #include "common/shadow.glsl"
@@ -15,7 +16,8 @@ layout(local_size_x = 64) in;
 void main() {
     if (gl_GlobalInvocationID.x >= min(u_recorded, u_capacity)) return;
     StaticFragment f = u_fragments[gl_GlobalInvocationID.x];
-    uvec3 lit = toFixedRadiance(lampReflected(f.albedo.rgb, f.world.xyz, f.normal.xyz));
+    vec3 irradiance = vec3(f.world.w, f.normal.w, f.albedo.w);
+    uvec3 lit = toFixedRadiance(lampReflected(f.albedo.rgb, irradiance, lampVisibility(f.world.xyz, f.normal.xyz)));
     ivec3 step = ivec3(equal(ivec3(f.voxel.w & 3), ivec3(0, 1, 2)));
     for (int k = 0; k < f.voxel.w >> 2; ++k) {
         ivec3 v = f.voxel.xyz + k * step;

@@ -4,9 +4,10 @@
 // light to their voxels. Everything else a wall's fragment adds (its count, albedo,
 // normal, emission) is in the static sums the frame's sums start from.
 struct StaticFragment {
-    vec4 world;   // xyz: the fragment's point; w unused
-    vec4 normal;  // xyz: its unit normal
-    vec4 albedo;  // rgb
+    vec4 world;   // xyz: the fragment's point; w: the lamp's unshadowed irradiance there, red
+    vec4 normal;  // xyz: its unit normal; w: the irradiance, green
+    vec4 albedo;  // rgb; a: the irradiance, blue (surface.glsl lampIrradiance: only the
+                  // shadow changes from frame to frame)
     ivec4 voxel;  // xyz: the first voxel of its depth span; w: axis | voxels in the span << 2
 };
 layout(std430, binding = 3) buffer StaticFragments {

@@ -14,18 +14,29 @@ uniform int u_res;          // voxels per side
 uniform float u_shadowBias;
 uniform bool u_unshadowed;  // the lamp dome (voxelize.cpp): the emitter, never in a shadow
 
-vec3 lampReflected(vec3 albedo, vec3 p, vec3 n) {
+// The lamp's irradiance at p, unshadowed: it changes only with the lamp (voxelize keeps
+// it with the walls' fragments, static_surfaces.glsl).
+vec3 lampIrradiance(vec3 p, vec3 n) {
+#if KILN_LAMP_FIELD
+    return u_lightColor.rgb * lampFieldSolidAngle(lampFieldAt(u_lampField, p), p, n);
+#else
+    return lampLight(p, n);
+#endif
+}
+
+// The fraction of the lamp's light that reaches p: one hard shadow-map test.
+float lampVisibility(vec3 p, vec3 n) {
     float vis = 1.0;
 #if KILN_HAS_SHADOW_MAP
     vis = u_unshadowed ? 1.0 : shadowHard(u_shadowMap, p + n * (2.0 / float(u_res)), u_shadowBias);
 #endif
-#if KILN_LAMP_FIELD
-    vec3 irradiance = u_lightColor.rgb * lampFieldSolidAngle(lampFieldAt(u_lampField, p), p, n);
-#else
-    vec3 irradiance = lampLight(p, n);
-#endif
-    return albedo / 3.14159265 * irradiance * vis;
+    return vis;
 }
+
+// Lit from a known irradiance (the one formula, so a kept irradiance gives the same sums).
+vec3 lampReflected(vec3 albedo, vec3 irradiance, float vis) { return albedo / 3.14159265 * irradiance * vis; }
+
+vec3 lampReflected(vec3 albedo, vec3 p, vec3 n) { return lampReflected(albedo, lampIrradiance(p, n), lampVisibility(p, n)); }
 
 // A sphere of radius r voxelized on voxels of side h (rasterized conservatively, or
 // splatted into the voxels its surface passes through) presents about (2r + h)² to a

@@ -57,7 +57,9 @@ void main() {
     if (slot < u_capacity) {
         ivec3 first = v_axis == 0 ? ivec3(k0, ij.x, ij.y) : v_axis == 1 ? ivec3(ij.y, k0, ij.x) : ivec3(ij, k0);
         int voxels = min(k1, k0 + 2) - k0 + 1;
-        u_fragments[slot] = StaticFragment(vec4(v_world, 0.0), vec4(n, 0.0), vec4(albedo, 0.0), ivec4(first, v_axis | voxels << 2));
+        vec3 irradiance = lampIrradiance(v_world, n);
+        u_fragments[slot] = StaticFragment(vec4(v_world, irradiance.r), vec4(n, irradiance.g), vec4(albedo, irradiance.b),
+                                           ivec4(first, v_axis | voxels << 2));
     }
 #else
     uvec3 lit = toFixedRadiance(lampReflected(albedo, v_world, n));
