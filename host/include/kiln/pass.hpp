@@ -141,6 +141,16 @@
 //   still computes them right and NVIDIA does not, so only a GPU shows the bug
 //   (tests/core/test_shader.cpp checks the shipped shaders' text for it).
 //
+// COST ON A CPU RASTERIZER
+//   Where there is no GPU (CI, Mesa's llvmpipe) a shader runs 8 pixels or invocations
+//   at a time, and an `if`, a `?:` or a loop body runs for all 8 whichever way they go:
+//   a branch on a uniform or on the data saves nothing, and a lookup behind it is paid
+//   everywhere (the floor's wood lookup behind `if`: 3.2 ms of the G-buffer's 9.9 at
+//   720²). Choose what runs with defines (ctx.program's .defines, one variant per case)
+//   or by drawing each variant over only what needs it, not with branches. Each texture
+//   lookup costs about a millisecond at 720²: a pass gets cheaper by fewer lookups a
+//   pixel, not by cheaper arithmetic. Measure with kiln-bench-render.
+//
 // GL STATE
 //   Before each pass the host resets: framebuffer 0 and the viewport to the output
 //   size; depth test off, depth func LESS, depth writes on; blending off, blend func
