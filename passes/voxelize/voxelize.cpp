@@ -250,9 +250,7 @@ private:
             glNamedBufferSubData(staticFragments_.id(), 0, sizeof header, header);
             glClearTexImage(staticSums.id, 0, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
             beginRaster(ctx, raster, res, staticSums.id);
-            glUniform1f(glGetUniformLocation(raster, "u_emissionScale"), ctx.getFloat("lamp_emission"));
-            glUniform1i(glGetUniformLocation(raster, "u_unshadowed"), 1);
-            ctx.drawScene({.categories = kiln::kSceneLamp, .lod = kiln::Lod::Low});
+            drawDome(ctx, raster);
             beginRaster(ctx, recorder, res, staticSums.id);
             glUniform1f(glGetUniformLocation(recorder, "u_emissionScale"), 1.0f);
             glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kStaticBinding, staticFragments_.id());
@@ -302,17 +300,21 @@ private:
         glUniform1f(glGetUniformLocation(raster, "u_conservative"), ctx.getBool("conservative") ? 1.0f : 0.0f);
     }
 
+    // The lamp dome into the sums `raster` is set up for (beginRaster): at lamp_emission,
+    // unshadowed (it is the emitter; nothing comes between it and the shadow map's eye).
+    static void drawDome(kiln::PassContext& ctx, GLuint raster) {
+        glUniform1f(glGetUniformLocation(raster, "u_emissionScale"), ctx.getFloat("lamp_emission"));
+        glUniform1i(glGetUniformLocation(raster, "u_unshadowed"), 1);
+        ctx.drawScene({.categories = kiln::kSceneLamp, .lod = kiln::Lod::Low});
+    }
+
     // 1–3: the box and the lamp (unless kept), the tumblers and whatever is not splatted,
     // rasterised into the sums (no attachments: the fragment shader only does atomics).
     void rasterize(kiln::PassContext& ctx, GLuint raster, int res, bool rasterStatic, bool rasterParticles,
                    bool rasterFireballs, bool rasterTumblers) {
         beginRaster(ctx, raster, res, ctx.internal("sums").id);
+        if (rasterStatic) drawDome(ctx, raster);
         const GLint emissionScale = glGetUniformLocation(raster, "u_emissionScale");
-        if (rasterStatic) {
-            glUniform1f(emissionScale, ctx.getFloat("lamp_emission"));
-            glUniform1i(glGetUniformLocation(raster, "u_unshadowed"), 1);
-            ctx.drawScene({.categories = kiln::kSceneLamp, .lod = kiln::Lod::Low});
-        }
         glUniform1i(glGetUniformLocation(raster, "u_unshadowed"), 0);
         uint32_t cats = (rasterStatic ? kiln::kSceneBox : 0u) | (rasterTumblers ? kiln::kSceneTumblers : 0u);
         if (rasterParticles) cats |= kiln::kSceneParticles;

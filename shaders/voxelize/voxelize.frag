@@ -21,6 +21,10 @@ flat in int v_axis;
 flat in vec4 v_aabb;
 flat in vec2 v_depthRange;
 
+// The voxel at depth index k of pixel column ij, projected along `axis`: the inverse of
+// the geometry shader's swizzle.
+ivec3 voxelAt(int k, ivec2 ij, int axis) { return axis == 0 ? ivec3(k, ij.x, ij.y) : axis == 1 ? ivec3(ij.y, k, ij.x) : ivec3(ij, k); }
+
 uniform float u_emissionScale;  // 1, or lamp_emission while drawing the lamp
 uniform bool u_sphereFlux;      // the fireballs: scale each to its sphere's flux (below)
 
@@ -49,24 +53,19 @@ void main() {
     int k0 = clamp(int(floor((zLo * 0.5 + 0.5) * float(u_res))), 0, u_res - 1);
     int k1 = clamp(int(floor((zHi * 0.5 + 0.5) * float(u_res))), 0, u_res - 1);
     ivec2 ij = clamp(ivec2(px), ivec2(0), ivec2(u_res - 1));
+    int kLast = min(k1, k0 + 2);
 #if KILN_RECORD_STATIC
     // A static surface: everything but its lamp light now, the fragment kept for
     // static_light.comp to light each frame.
     uvec3 lit = uvec3(0u);
     uint slot = atomicAdd(u_recorded, 1u);
     if (slot < u_capacity) {
-        ivec3 first = v_axis == 0 ? ivec3(k0, ij.x, ij.y) : v_axis == 1 ? ivec3(ij.y, k0, ij.x) : ivec3(ij, k0);
-        int voxels = min(k1, k0 + 2) - k0 + 1;
         vec3 irradiance = lampIrradiance(v_world, n);
         u_fragments[slot] = StaticFragment(vec4(v_world, irradiance.r), vec4(n, irradiance.g), vec4(albedo, irradiance.b),
-                                           ivec4(first, v_axis | voxels << 2));
+                                           ivec4(voxelAt(k0, ij, v_axis), v_axis | (kLast - k0 + 1) << 2));
     }
 #else
     uvec3 lit = toFixedRadiance(lampReflected(albedo, v_world, n));
 #endif
-    for (int k = k0; k <= min(k1, k0 + 2); ++k) {
-        // Back from (2D, depth) to (x, y, z): the inverse of the geometry shader's swizzle.
-        addSurfaceToVoxel(v_axis == 0 ? ivec3(k, ij.x, ij.y) : v_axis == 1 ? ivec3(ij.y, k, ij.x) : ivec3(ij, k), lit,
-                          emitted, albedo, n);
-    }
+    for (int k = k0; k <= kLast; ++k) addSurfaceToVoxel(voxelAt(k, ij, v_axis), lit, emitted, albedo, n);
 }
