@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <chrono>
 #include <fstream>
-#include <set>
 #include <sstream>
 
 #include "graph/compiler.hpp"
@@ -203,15 +202,6 @@ void Runtime::createPassObject(PassSlot& slot, const graph::PlannedPass& planned
     }
     slot.error = slot.pass ? std::string() : error;
     slot.invalidate(false);
-}
-
-// Every enabled pass of module `name` gets an object of the module now registered; the
-// old objects go first (their code lives in the old library), and the slots keep their
-// textures and parameters.
-void Runtime::recreatePassObjects(const std::string& name) {
-    for (size_t i = 0; i < slots_.size(); ++i)
-        if (slots_[i]->module == name && plan_->passes[i].state != graph::PassState::Disabled)
-            createPassObject(*slots_[i], plan_->passes[i]);
 }
 
 // The library's destroy() runs under the guard; a fault there is printed once, and
@@ -415,48 +405,6 @@ void Runtime::runPass(size_t i, const FrameResources& shared, const SceneView& v
     for (auto& [name, tex] : slot.textures) tex.version = ++versionCounter_;
 }
 
-// The object of a faulted library is abandoned, not destroyed: none of that library's
-// code runs again. Its textures keep their last good contents for the passes after it.
-void Runtime::retireFaultedObject(PassSlot& slot) {
-    (void)slot.pass.release();
-    slot.error = slot.library->fault();
-    slot.lastRunKey.reset();
-}
-
-// After the frame (the plan cannot change under runPass): each module that faulted goes
-// back to the build it replaced, with the running parameters, when there is one; or
-// its passes stay off until its file changes. Either way the fault is logged once and
-// stands in activeErrors until a reload of that module succeeds.
-void Runtime::recoverFromFaults() {
-    std::set<std::string> faulted;
-    faulted.swap(faultedModules_);
-    for (const std::string& name : faulted) {
-        const ModuleRegistry::Module* current = modules_->find(name);
-        if (!current || !current->library->faulted()) continue;
-        const ModuleRegistry::Module broken = *current;
-        const std::string file = broken.library->sourcePath().filename().string();
-        std::string outcome = offUntilChanged(*broken.library);
-        if (const ModuleRegistry::Module* previous = modules_->previous(name)) {
-            modules_->set(name, *previous);
-            std::string errors;
-            if (desc_ && loadPipelineDesc(*desc_, errors)) {
-                modules_->keepAsPrevious(name, broken);  // faulted: forgets it
-                recreatePassObjects(name);
-                outcome = "; rolled back to the build loaded before it, until " + file + " changes";
-            } else {
-                modules_->set(name, broken);
-            }
-        }
-        const std::string message = broken.library->fault() + outcome;
-        setExternalError("module:" + name, message);
-        if (broken.library->takeFaultToReport()) log::error(message);
-    }
-}
-
-std::string Runtime::offUntilChanged(const LoadedModule& library) {
-    return "; its passes are off until " + library.sourcePath().filename().string() + " changes";
-}
-
 // A clean slate for every pass, so one pass's GL state never leaks into the next
 // (the list is the pass manual's, kiln/pass.hpp "GL STATE").
 void Runtime::resetGlState() const {
@@ -573,30 +521,6 @@ int Runtime::reloadShaders(const std::vector<fs::path>& changed) {
         rebuilt += n;
     }
     return rebuilt;
-}
-
-bool Runtime::reloadModule(const std::string& name, std::string& error) {
-    auto probed = modules_->probe(name);
-    if (!probed) {
-        error = probed.errorText();
-        if (!error.empty() && error.back() == '\n') error.pop_back();
-        return false;
-    }
-    // Validate the running description (the file with the debug view's edits) against
-    // the new declaration before touching anything.
-    std::optional<ModuleRegistry::Module> old;
-    if (const ModuleRegistry::Module* m = modules_->find(name)) old = *m;
-    modules_->set(name, *probed);
-    std::string errors;
-    if (desc_ && !loadPipelineDesc(*desc_, errors)) {
-        if (old) modules_->set(name, *old);
-        else modules_->erase(name);
-        error = errors;
-        return false;
-    }
-    if (old) modules_->keepAsPrevious(name, *old);
-    recreatePassObjects(name);
-    return true;
 }
 
 }  // namespace kiln::run
