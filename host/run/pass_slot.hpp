@@ -30,6 +30,8 @@ struct PassSlot {
     int settlingFrames = 0;                           // runs left that keepRunning asked for
     bool lastRunByScene = false;                      // its last run changed only what bodies moving change
     int convergingRuns = 0;                           // runs left of settling after a change to everything
+    uint64_t setup = 0;                               // its textures' TextureRef::setup
+    std::vector<uint64_t> inputSetups;                // each input's setup at its last run
     std::string settlingReason;
     std::string error;                                // why the last execute failed
     std::string loggedError;                          // the last error printed (once each)

@@ -288,6 +288,34 @@ bool Runtime::runsForBodiesOnly(const graph::PlannedPass& planned, const PassSlo
     return true;
 }
 
+// Whether this run's outputs differ from the last run's only through instances moving
+// (kiln/pass.hpp, REUSING WHAT DID NOT CHANGE): the pass ran last time and was not
+// still converging, it does not read time, and what differs from that run's key is
+// instance categories it reads or inputs whose setup is what it was then.
+bool Runtime::changedOnlyByInstances(const graph::PlannedPass& planned, const PassSlot& slot,
+                                     const std::vector<uint64_t>& key, bool converging) const {
+    constexpr uint32_t kInstanceCategories = kSceneBodies | kSceneParticles;
+    if (converging || planned.decl.timeDependent || !slot.lastRunKey || slot.lastRunKey->size() != key.size() ||
+        slot.inputSetups.size() != planned.bindings.size())
+        return false;
+    const std::vector<uint64_t>& last = *slot.lastRunKey;
+    const size_t inputs = planned.bindings.size(), scene = inputs + kSceneCategoryCount;
+    for (size_t k = 0; k < key.size(); ++k) {
+        if (key[k] == last[k]) continue;
+        if (k >= scene) return false;  // the output size or the programs
+        if (k >= inputs) {
+            if (!((1u << (k - inputs)) & kInstanceCategories)) return false;
+        } else if (inputSetup(planned.bindings[k]) != slot.inputSetups[k]) {
+            return false;
+        }
+    }
+    return true;
+}
+
+uint64_t Runtime::inputSetup(const graph::Binding& b) const {
+    return b.bound() ? slots_[static_cast<size_t>(b.producer)]->setup : 0;
+}
+
 void Runtime::renderFrame(const SceneView& view, const SceneDraw& scene, const FrameInfo& frameIn) {
     const auto start = std::chrono::steady_clock::now();
     cost_ = {};
@@ -340,6 +368,7 @@ void Runtime::runPass(size_t i, const FrameResources& shared, const SceneView& v
     }
     FrameInfo passFrame = frame;
     if (!runsForBodiesOnly(planned, slot, key, settling, frame)) passFrame.redrawCount = 0;
+    const bool byInstances = changedOnlyByInstances(planned, slot, key, slot.settlingFrames > 0);
     if (settling) --slot.settlingFrames;
     else slot.settlingFrames = 0;  // a change: the pass says again whether it needs more frames
 
@@ -402,7 +431,10 @@ void Runtime::runPass(size_t i, const FrameResources& shared, const SceneView& v
                   " % of the picture to redraw");
     }
     t.note("ran", why);
-    for (auto& [name, tex] : slot.textures) tex.version = ++versionCounter_;
+    if (!byInstances) slot.setup = ++versionCounter_;
+    slot.inputSetups.clear();
+    for (auto& b : planned.bindings) slot.inputSetups.push_back(inputSetup(b));
+    for (auto& [name, tex] : slot.textures) tex.version = ++versionCounter_, tex.ref.setup = slot.setup;
 }
 
 // A clean slate for every pass, so one pass's GL state never leaks into the next

@@ -127,6 +127,9 @@ private:
     std::vector<uint64_t> runKey(const graph::PlannedPass&, const PassSlot&, const SceneView&) const;
     bool runsForBodiesOnly(const graph::PlannedPass&, const PassSlot&, const std::vector<uint64_t>& key, bool settling,
                            const FrameInfo&) const;
+    bool changedOnlyByInstances(const graph::PlannedPass&, const PassSlot&, const std::vector<uint64_t>& key,
+                                bool converging) const;
+    uint64_t inputSetup(const graph::Binding&) const;
     void runPass(size_t pass, const FrameResources&, const SceneView&, const FrameInfo&);
     void resetGlState() const;
     void retireFaultedObject(PassSlot&);

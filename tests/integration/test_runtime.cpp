@@ -118,6 +118,50 @@ TEST_CASE("a pass whose inputs, parameters and scene did not change is skipped",
     }
 }
 
+TEST_CASE("a texture's setup stays while only instances move, and changes with anything else that made it",
+          "[runtime][gl]") {
+    // TextureRef::setup (kiln/pass.hpp, REUSING WHAT DID NOT CHANGE): what a pass may
+    // compare to reuse what it computed from an input where no instance moved.
+    Fixture f;
+    f.app.frame();
+    f.app.settle();
+    auto setup = [&](const char* pass, const char* name) {
+        const TextureRef* t = f.app.runtime().findTexture(pass, name);
+        REQUIRE(t);
+        return t->setup;
+    };
+    const uint64_t gbuffer = setup("gbuffer", "albedo"), shadow = setup("shadow", "depth");
+    const uint64_t mips = setup("voxel_mip", "iso");
+    CHECK(gbuffer != 0);
+    CHECK(shadow != 0);
+    // The scene running: the bodies move, time passes.
+    f.app.paused = false;
+    for (int i = 0; i < 3; ++i) f.app.frame();
+    CHECK(setup("gbuffer", "albedo") == gbuffer);
+    CHECK(setup("shadow", "depth") == shadow);
+    // voxel_mip feeds its bounces back (keepRunning): its volumes change with nothing
+    // moving too.
+    CHECK(setup("voxel_mip", "iso") != mips);
+    f.app.paused = true;
+    // A parameter: its pass and those after it, not the others.
+    std::string error;
+    REQUIRE(f.app.runtime().setParam("gbuffer", "particles", false, error));
+    f.app.frame();
+    const uint64_t gbuffer2 = setup("gbuffer", "albedo");
+    CHECK(gbuffer2 != gbuffer);
+    CHECK(setup("composite", "color") != 0);
+    CHECK(setup("shadow", "depth") == shadow);
+    // The camera: what reads it.
+    f.app.camera().yaw += 0.1f;
+    f.app.frame();
+    CHECK(setup("gbuffer", "albedo") != gbuffer2);
+    CHECK(setup("shadow", "depth") == shadow);
+    // The shadow map's parameter, with nothing moving: its depths change in place.
+    REQUIRE(f.app.runtime().setParam("shadow", "slope_bias", 8.0f, error));
+    f.app.frame();
+    CHECK(setup("shadow", "depth") != shadow);
+}
+
 TEST_CASE("a pass that asks to keep running gets its frames after each change, not more, and then skips",
           "[runtime][gl]") {
     // The default's voxel_mip feeds its bounces back and asks for 16 frames after each

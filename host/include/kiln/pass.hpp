@@ -93,6 +93,17 @@
 //   yours still converging, your last run failed): redraw everything. Ignoring it is
 //   always correct, only slower.
 //
+// REUSING WHAT DID NOT CHANGE
+//   A pass may keep what it computed from an input and redo only where instances
+//   moved, while that input's TextureRef::setup is the one it last saw: then nothing
+//   but the scene's instances changed upstream (the camera, the lamp, the box, time,
+//   parameters, programs and sizes did not). Where the movement reaches depends on the
+//   producer (gbuffer: the instances' own pixels; shadow: the casters' texels; voxels:
+//   the light they bounce, everywhere), so such a pass says which producers it assumes
+//   and has a parameter to turn the reuse off. The instance buffer is the same at every
+//   pass of a frame: a copy of it kept by the pass tells what moved since its last run
+//   (composite's direct light: passes/composite).
+//
 // EXECUTING
 //   ctx.input/output/internal("name") give a TextureRef (GL name + shape); asking for
 //   a name you did not declare fails the pass with a message naming it.
@@ -199,9 +210,9 @@ namespace kiln {
 // or when what the host does for a pass changes (6: the host issues the barrier
 // between passes; 7: GpuFrame::boxWalls; 8: PassContext::keepRunning; 9:
 // SizeRule::capSource and Lod::Medium; 10: ProgramBuild::portability; 11:
-// FrameInfo::redraw), so a module
+// FrameInfo::redraw; 12: TextureRef::setup), so a module
 // built for other terms is refused by name, not run.
-inline constexpr uint32_t kPassAbiVersion = 11;
+inline constexpr uint32_t kPassAbiVersion = 12;
 
 struct TextureRef {
     GLuint id = 0;
@@ -209,6 +220,13 @@ struct TextureRef {
     GLenum format = 0;          // internal format
     int width = 0, height = 0, depth = 1, levels = 1;
     bool bound = false;         // false: a fallback texture stands in
+    // Changes whenever the producer (or a pass before it) wrote this texture for any
+    // reason but instances moving (tumblers, marbles, fireballs, particles): a
+    // parameter, a program, a size, a reload, a failed run, the camera, the lamp, the
+    // box, time, a pass still converging (keepRunning). While it is unchanged, the
+    // texture differs from when you last read it only through instances that moved
+    // (REUSING WHAT DID NOT CHANGE). 0 for a fallback.
+    uint64_t setup = 0;
 };
 
 // A rectangle of pixels as glScissor takes it: lower-left corner, width and height.
