@@ -3,15 +3,27 @@
 // PCF lookup from its centre), plus albedo × indirect irradiance, emission and bloom.
 // `hdr` is the radiance estimate before bloom and exposure, the image the error
 // metrics compare with the reference.
+// KILN_DIRECT: 0 computes the lamp's light here; 1 does and also writes it to `direct`
+// (the pass's cache: everything that depends only on the G-buffer, the shadow map and
+// the lamp, as halves; alpha the frame that computed it); 2 reads it from there. 1 and 2 shade from it by the same function, so a
+// pixel comes out the same whichever drew it (composite.cpp, keep_direct).
 #include "common/frame.glsl"
 #include "common/light.glsl"
 #include "common/shadow.glsl"
 #include "common/lamp_field.glsl"
 #include "common/tonemap.glsl"
 
-in vec2 v_uv;
+#ifndef KILN_DIRECT
+#define KILN_DIRECT 0
+#endif
 layout(location = 0) out vec4 o_color;
 layout(location = 1) out vec4 o_hdr;
+#if KILN_DIRECT == 1
+layout(location = 2) out vec4 o_direct;
+#endif
+#if KILN_DIRECT == 2
+layout(binding = 9) uniform sampler2D u_direct;
+#endif
 
 layout(binding = 0) uniform sampler2D u_albedo;
 layout(binding = 1) uniform sampler2D u_normal;
@@ -112,55 +124,92 @@ vec3 worldPosition(vec2 uv, float depth) {
     return p.xyz / p.w;
 }
 
+// The lamp's light at the pixel before the fire dims it: albedo / π × irradiance ×
+// the shadow test; 0 where no geometry is.
+vec3 lampDirect(ivec2 px, vec2 uv, vec4 n4, vec3 albedo) {
+    if (n4.w <= 0.5) return vec3(0.0);
+    vec3 p = worldPosition(uv, texelFetch(u_depth, px, 0).r);
+    vec3 n = normalize(n4.xyz);
+#if KILN_LAMP_TRACED || KILN_LAMP_FIELD
+    // traced: cone_trace's `lamp`, the projected solid angle where it traced,
+    // upsampled. field: from the lamp's vector irradiance F on a grid, n·F (exact up
+    // to the grid where the whole emitter is above the surface's horizon) or, where
+    // the horizon cuts it, the clipped form of the ball F describes (common/lamp_field.glsl).
+    // Within u_lampNearField of the dome both change faster than their samples:
+    // evaluated here, by the variant composite.cpp draws over the near field's
+    // screen rectangle only (on llvmpipe the contour's mere presence in the shader
+    // cost every pixel of the frame, used or not).
+#if KILN_LAMP_FIELD
+    float solidAngle = lampFieldSolidAngle(lampFieldAt(u_lampField, p), p, n);
+#else
+    float solidAngle = texture(u_indirect, uv).a;
+#endif
+#if KILN_LAMP_NEAR_FIELD
+    if (distance(p, u_lightPos.xyz) < u_lightPos.w + u_lampNearField) solidAngle = lampProjectedSolidAngle(p, n);
+#endif
+    vec3 irradiance = u_lightColor.rgb * solidAngle;
+#else
+    vec3 irradiance = lampLight(p, n);
+#endif
+    float visible = max(irradiance.r, max(irradiance.g, irradiance.b)) > 0.0 ? lightVisibility(p + n * 0.004) : 0.0;
+    return albedo / 3.14159265 * irradiance * visible;
+}
+
+// The pixel's radiance from its lamp light (lampDirect): dimmed by the fire, plus the
+// fireballs' light, albedo × the indirect light, and its emission. Where no geometry is
+// the albedo and the lamp light are 0 (gbuffer's background): emission only.
+vec3 shade(ivec2 px, vec2 uv, vec3 lampLit, vec3 albedo) {
+    vec4 indirectLight = texture(u_indirect, uv);
+    vec3 direct = lampLit;
+#if KILN_LAMP_THROUGH_FIRE
+    direct *= indirectLight.a;  // through the fire (common/fire.glsl), upsampled
+#endif
+#if KILN_FIREBALLS_ANALYTIC
+    if (texelFetch(u_normal, px, 0).w > 0.5) {
+        vec3 p = worldPosition(uv, texelFetch(u_depth, px, 0).r);
+        direct += albedo / 3.14159265 * fireballIrradiance(p, normalize(texelFetch(u_normal, px, 0).xyz));
+    }
+#endif
+#if KILN_HAS_INDIRECT
+    vec3 indirect = albedo * u_indirectStrength * indirectLight.rgb;
+#else
+    vec3 indirect = albedo * u_ambient;
+#endif
+    // The optional emission may be the 1×1 fallback: clamped.
+    return direct + indirect + texelFetch(u_emissive, min(px, textureSize(u_emissive, 0) - 1), 0).rgb;
+}
+
+// The lamp light as `direct` keeps it (RGBA16F: an RGBA32F fetch cost llvmpipe 3.5 ms at
+// 720², a half one about 2): rounded to halves, below the smallest normal half taken
+// as 0 (a render target may flush what packHalf2x16 keeps). Every variant shades from
+// it so, whether it computed the light or read it back: the picture is the same
+// with keep_direct on or off (the hdr output is halves too).
+// Rounded to 11 significant bits, to nearest even, by integer steps (packHalf2x16 and
+// back cost more on llvmpipe); the light is ≥ 0 and far below the largest half.
+vec3 asKept(vec3 light) {
+    uvec3 bits = floatBitsToUint(light);
+    bits = (bits + 0xFFFu + ((bits >> 13) & 1u)) & ~0x1FFFu;
+    return mix(uintBitsToFloat(bits), vec3(0.0), lessThan(light, vec3(6.103515625e-5)));
+}
+
 void main() {
     // The G-buffer inputs are the output's size: texel fetches. The indirect light and
     // the bloom may be smaller (cone_trace.output_divisor, bloom at half size): filtered.
+    // Coordinates from the fragment, not a varying: every way this shader is drawn
+    // (the screen's triangle, composite.cpp's tiles) reads the same.
     ivec2 px = ivec2(gl_FragCoord.xy);
-    vec4 n4 = texelFetch(u_normal, px, 0);
-    // The optional ones may be the 1×1 fallback: clamped.
-    vec3 emissive = texelFetch(u_emissive, min(px, textureSize(u_emissive, 0) - 1), 0).rgb;
-    vec3 radiance = vec3(0.0);
-    if (n4.w > 0.5) {
-        vec3 albedo = texelFetch(u_albedo, px, 0).rgb;
-        vec3 p = worldPosition(v_uv, texelFetch(u_depth, px, 0).r);
-        vec3 n = normalize(n4.xyz);
-#if KILN_LAMP_TRACED || KILN_LAMP_FIELD
-        // traced: cone_trace's `lamp`, the projected solid angle where it traced,
-        // upsampled. field: from the lamp's vector irradiance F on a grid, n·F (exact up
-        // to the grid where the whole emitter is above the surface's horizon) or, where
-        // the horizon cuts it, the clipped form of the ball F describes (common/lamp_field.glsl).
-        // Within u_lampNearField of the dome both change faster than their samples:
-        // evaluated here, by the variant composite.cpp draws over the near field's
-        // screen rectangle only (on llvmpipe the contour's mere presence in the shader
-        // cost every pixel of the frame, used or not).
-#if KILN_LAMP_FIELD
-        float solidAngle = lampFieldSolidAngle(lampFieldAt(u_lampField, p), p, n);
+    vec2 uv = gl_FragCoord.xy * u_outputSize.zw;
+    vec3 albedo = texelFetch(u_albedo, px, 0).rgb;
+#if KILN_DIRECT == 2
+    vec3 lampLit = texelFetch(u_direct, px, 0).rgb;
 #else
-        float solidAngle = texture(u_indirect, v_uv).a;
+    vec3 lampLit = asKept(lampDirect(px, uv, texelFetch(u_normal, px, 0), albedo));
 #endif
-#if KILN_LAMP_NEAR_FIELD
-        if (distance(p, u_lightPos.xyz) < u_lightPos.w + u_lampNearField) solidAngle = lampProjectedSolidAngle(p, n);
+#if KILN_DIRECT == 1
+    o_direct = vec4(lampLit, mod(u_time.z, 1024.0) + 1.0);  // a: the frame that computed it (mod 1024) + 1
 #endif
-        vec3 irradiance = u_lightColor.rgb * solidAngle;
-#else
-        vec3 irradiance = lampLight(p, n);
-#endif
-        float visible = max(irradiance.r, max(irradiance.g, irradiance.b)) > 0.0 ? lightVisibility(p + n * 0.004) : 0.0;
-#if KILN_LAMP_THROUGH_FIRE
-        visible *= texture(u_indirect, v_uv).a;  // through the fire (common/fire.glsl), upsampled
-#endif
-        vec3 direct = albedo / 3.14159265 * irradiance * visible;
-#if KILN_FIREBALLS_ANALYTIC
-        direct += albedo / 3.14159265 * fireballIrradiance(p, n);
-#endif
-        vec3 indirect = albedo * u_indirectStrength * texture(u_indirect, v_uv).rgb;
-#if KILN_HAS_INDIRECT == 0
-        indirect = albedo * u_ambient;
-#endif
-        radiance = direct + indirect;
-    }
-    radiance += emissive;
+    vec3 radiance = shade(px, uv, lampLit, albedo);
     o_hdr = vec4(radiance, 1.0);
-    vec3 shown = (radiance + texture(u_bloom, v_uv).rgb) * u_exposure;
+    vec3 shown = (radiance + texture(u_bloom, uv).rgb) * u_exposure;
     o_color = vec4(displayEncode(shown, u_tonemap, u_gamma), 1.0);
 }

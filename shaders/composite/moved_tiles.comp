@@ -1,0 +1,152 @@
+#version 450 core
+// Marks the tiles of the picture whose lamp light (composite's `direct`) an instance
+// that changed since the pass's last run can have changed, and keeps this run's
+// instances for the next. One invocation per instance from u_first (the first tumbler;
+// the walls and the lamp changing redraw everything, composite.cpp).
+// An instance changes the G-buffer inside its box's screen rectangle, where it was and
+// where it is. A shadow caster also changes the shadow map inside its box's rectangle in
+// the map, and so the light of what lies in its shadow's pyramid (markShadow). A
+// rectangle that reaches behind the camera or the lamp's eye marks everything.
+#include "common/frame.glsl"
+#include "common/shadow.glsl"
+#include "common/instances.glsl"
+
+layout(local_size_x = 64) in;
+
+layout(std430, binding = 1) buffer PreviousInstances { KilnInstance previous[]; };
+layout(std430, binding = 2) buffer TileMarks { uint tileMarks[]; };
+uniform uint u_first, u_end;      // the instances compared: [u_first, u_end)
+uniform uint u_previousEnd;       // u_end at the last run
+uniform uint u_tumblersEnd;       // [u_first, u_tumblersEnd) are tumblers
+uniform uint u_castersEnd;        // [u_first, u_castersEnd) cast shadows (tumblers, marbles)
+uniform bool u_markAll;           // a full run: only keep the instances
+uniform ivec2 u_tiles;            // tiles across and down
+uniform int u_tileSize;
+uniform float u_shadowReachTexels;  // how far from its point a pixel's filter reads the map
+uniform vec2 u_shadowTexel;         // 1 / the map's size; 0: no map bound
+
+void markPixels(vec2 lo, vec2 hi) {  // pixel coordinates, inclusive bounds grown by one
+    ivec2 a = clamp(ivec2(floor(lo)) - 1, ivec2(0), u_tiles * u_tileSize - 1) / u_tileSize;
+    ivec2 b = clamp(ivec2(ceil(hi)) + 1, ivec2(0), u_tiles * u_tileSize - 1) / u_tileSize;
+    for (int y = a.y; y <= b.y; ++y)
+        for (int x = a.x; x <= b.x; ++x) tileMarks[y * u_tiles.x + x] = 1u;
+}
+
+void markEverything() { markPixels(vec2(0.0), vec2(u_tiles * u_tileSize)); }
+
+// The screen rectangle of a world box: its corners projected.
+void markWorldBox(vec3 lo, vec3 hi) {
+    vec2 a = vec2(1e30), b = vec2(-1e30);
+    for (int i = 0; i < 8; ++i) {
+        vec3 corner = mix(lo, hi, vec3(i & 1, (i >> 1) & 1, (i >> 2) & 1));
+        vec4 clip = u_viewProj * vec4(corner, 1.0);
+        if (clip.w <= 1e-4) { markEverything(); return; }
+        a = min(a, clip.xy / clip.w), b = max(b, clip.xy / clip.w);
+    }
+    markPixels((clamp(a, -1.0, 1.0) * 0.5 + 0.5) * u_outputSize.xy, (clamp(b, -1.0, 1.0) * 0.5 + 0.5) * u_outputSize.xy);
+}
+
+// An instance's box: a sphere's (marbles, fireballs, particles: the unit sphere placed),
+// or the tumbler's, its two balls' (its round cone is their convex hull: about its
+// origin, the lower ball of radius b and the upper of radius t at y_t), 5 % wider for
+// the mesh.
+void instanceBox(KilnInstance inst, bool tumbler, out vec3 lo, out vec3 hi) {
+    mat4 m = inst.model;
+    float scale = max(length(m[0].xyz), max(length(m[1].xyz), length(m[2].xyz))) * 1.05;
+    if (!tumbler) {
+        lo = m[3].xyz - scale, hi = m[3].xyz + scale;
+        return;
+    }
+    vec3 upper = (m * vec4(0.0, u_tumblerShape.w, 0.0, 1.0)).xyz;
+    lo = min(m[3].xyz - scale * u_tumblerShape.x, upper - scale * u_tumblerShape.y);
+    hi = max(m[3].xyz + scale * u_tumblerShape.x, upper + scale * u_tumblerShape.y);
+}
+
+// Where a caster's shadow can have changed: on what lies in the pyramid from the map's
+// eye through the caster's rectangle in the map (grown by the filter's reach), from the
+// caster's top down to the floor (nearer the lamp than the caster a depth test comes out
+// lit either way). The walls there: for each wall, the pyramid's part within 1 cm of
+// it, bounded by where its edges cross that slab and its corners inside it. The
+// instances there, wherever they are: each one's own box, but those of no albedo (the
+// particles: no lamp light to change). The dome, if the pyramid reaches it.
+vec3 pyramid[8];  // corners: i & 3 the ray, i >> 2 top (0) or bottom (1)
+const ivec2 kPyramidEdges[12] = ivec2[](ivec2(0, 1), ivec2(1, 3), ivec2(3, 2), ivec2(2, 0), ivec2(4, 5), ivec2(5, 7),
+                                        ivec2(7, 6), ivec2(6, 4), ivec2(0, 4), ivec2(1, 5), ivec2(2, 6), ivec2(3, 7));
+
+void markWallInPyramid(int axis, float side) {
+    vec3 lo = vec3(1e30), hi = vec3(-1e30);
+    const float slab = 0.01;
+    for (int i = 0; i < 8; ++i)
+        if (abs(pyramid[i][axis] - side) <= slab) lo = min(lo, pyramid[i]), hi = max(hi, pyramid[i]);
+    for (int e = 0; e < 12; ++e) {
+        vec3 p = pyramid[kPyramidEdges[e].x], q = pyramid[kPyramidEdges[e].y];
+        for (int k = 0; k < 2; ++k) {
+            float plane = side + (k == 0 ? -slab : slab);
+            float t = (plane - p[axis]) / (q[axis] - p[axis]);
+            if (q[axis] != p[axis] && t >= 0.0 && t <= 1.0) {
+                vec3 c = mix(p, q, t);
+                lo = min(lo, c), hi = max(hi, c);
+            }
+        }
+    }
+    lo = max(lo, vec3(-1.0 - slab)), hi = min(hi, vec3(1.0 + slab));  // the wall's extent
+    if (all(lessThanEqual(lo, hi))) markWorldBox(lo, hi);
+}
+
+void markShadow(vec3 lo, vec3 hi) {
+    mat4 toMap = lightViewProj();
+    vec2 a = vec2(1e30), b = vec2(-1e30);
+    for (int i = 0; i < 8; ++i) {
+        vec4 clip = toMap * vec4(mix(lo, hi, vec3(i & 1, (i >> 1) & 1, (i >> 2) & 1)), 1.0);
+        if (clip.w <= 1e-4) { markEverything(); return; }
+        a = min(a, clip.xy / clip.w), b = max(b, clip.xy / clip.w);
+    }
+    vec2 reach = 2.0 * u_shadowReachTexels * u_shadowTexel;  // texels in the map's [-1, 1]
+    a -= reach, b += reach;
+    mat4 fromMap = inverse(toMap);
+    vec3 eye = lightEye();
+    // Receivers are offset 4 mm along their normal before the lookup (composite.frag).
+    float top = hi.y + 0.01, bottom = -1.02;
+    vec3 boxLo = vec3(1e30), boxHi = vec3(-1e30);
+    for (int i = 0; i < 4; ++i) {
+        vec4 q = fromMap * vec4(mix(a, b, vec2(i & 1, i >> 1)), 0.0, 1.0);
+        vec3 dir = q.xyz / q.w - eye;
+        if (dir.y >= -1e-6) { markEverything(); return; }
+        for (int k = 0; k < 2; ++k) {
+            vec3 p = eye + dir * (((k == 0 ? top : bottom) - eye.y) / dir.y);
+            pyramid[i + 4 * k] = p;
+            boxLo = min(boxLo, p), boxHi = max(boxHi, p);
+        }
+    }
+    // The lamp's dome, where a caster reaches below its lowest point.
+    if (top > u_lightPos.y - u_lightPos.w) markWorldBox(u_lightPos.xyz - u_lightPos.w, u_lightPos.xyz + u_lightPos.w);
+    for (int wall = 0; wall < 6; ++wall)
+        if ((u_boxWalls.x & (1u << wall)) != 0u) markWallInPyramid(wall >> 1, (wall & 1) == 0 ? -1.0 : 1.0);
+    for (uint r = u_first; r < u_end; ++r) {
+        KilnInstance receiver = kiln_instances[r];
+        if (receiver.albedo.rgb == vec3(0.0)) continue;
+        vec3 rLo, rHi;
+        instanceBox(receiver, r < u_tumblersEnd, rLo, rHi);
+        if (all(lessThanEqual(max(rLo, boxLo), min(rHi, boxHi)))) markWorldBox(rLo, rHi);
+    }
+}
+
+bool sameInstance(KilnInstance x, KilnInstance y) {
+    return x.model == y.model && x.albedo == y.albedo && x.emissive == y.emissive;
+}
+
+void main() {
+    uint i = u_first + gl_GlobalInvocationID.x;
+    bool now = i < u_end, before = i < u_previousEnd;  // the particles come and go at the end
+    if (!now && !before) return;
+    if (!u_markAll && !(now && before && sameInstance(kiln_instances[i], previous[i]))) {
+        for (int k = 0; k < 2; ++k) {
+            if (!(k == 0 ? before : now)) continue;
+            vec3 lo, hi;
+            instanceBox(k == 0 ? previous[i] : kiln_instances[i], i < u_tumblersEnd, lo, hi);
+            markWorldBox(lo, hi);
+            if (i < u_castersEnd && u_shadowTexel.x > 0.0) markShadow(lo, hi);
+        }
+    }
+    if (now) previous[i] = kiln_instances[i];
+}
