@@ -8,13 +8,14 @@
 // starting one later (a slow minute of a shared machine, or a slow slot, lands on all of
 // them); figures are medians over rounds.
 //
-// skip: the default pipeline and scene in seven situations, one after the other in one
+// skip: the default pipeline and scene in eleven situations, one after the other in one
 // process: moving; paused (nothing changes: every pass may skip, once voxel_mip's
 // feedback has settled); moving without fireballs (no particles, no moving emitters);
 // moving with bloom culled (composite does not read it); moving with bloom disabled;
 // the tumblers asleep and no balls (time runs, nothing moves; settled too); and one
 // marble bouncing among the sleeping tumblers, redrawing only the part of the picture it
-// changes (kiln/pass.hpp) and, to compare, all of it. Per situation: each pass's median GPU and
+// changes (kiln/pass.hpp) and, to compare, all of it; and the fireballs flying among
+// the sleeping tumblers, with composite's kept lamp light and without. Per situation: each pass's median GPU and
 // CPU ms over the frames it ran, how often it ran, and the median wall time per frame
 // (with a glFinish, what a user waits for), and the ratio to "moving".
 //
@@ -167,26 +168,28 @@ std::string withoutFireballs(const std::string& sceneFile, const fs::path& dir) 
 }
 
 // The scene with its tumblers upright (they fall asleep after half a second at rest), no
-// fireballs and, with `oneMarble`, a single marble bouncing in place in a free corner
-// (elastic, frictionless: it never stops): what a scene where almost nothing moves costs.
-std::string restingScene(const std::string& sceneFile, const fs::path& dir, bool oneMarble) {
+// marbles, no fireballs (or, with `fire`, the shipped ones and their particles) and, with
+// `oneMarble`, a single marble bouncing in place in a free corner (elastic,
+// frictionless: it never stops): what a scene where almost nothing moves costs.
+std::string restingScene(const std::string& sceneFile, const fs::path& dir, bool oneMarble, bool fire = false) {
     Json j = Json::parse(slurp(sceneFile));
     for (auto& t : j["tumblers"]) t["tilt"] = Json::array({0.0, 0.0});
-    j["fireballs"] = Json::array();
+    if (!fire) j["fireballs"] = Json::array();
     j["marbles"] = Json::array();
     if (oneMarble)
         j["marbles"].push_back({{"position", {0.85, 0.2, -0.85}}, {"velocity", {0.0, 0.0, 0.0}}, {"radius", 0.05},
                                 {"color", {0.9, 0.9, 0.95}}});
-    const fs::path out = dir / (oneMarble ? "cornell-one-marble.json" : "cornell-asleep.json");
+    const fs::path out = dir / (fire ? "cornell-fire.json" : oneMarble ? "cornell-one-marble.json" : "cornell-asleep.json");
     std::ofstream(out) << j.dump(2);
     return out.string();
 }
 
-std::string editedPipeline(const std::string& text, bool cullBloom, bool disableBloom) {
+std::string editedPipeline(const std::string& text, bool cullBloom, bool disableBloom, bool keepDirect = true) {
     Json j = Json::parse(text);
     for (auto& p : j["passes"]) {
         if (disableBloom && p["id"] == "bloom") p["enabled"] = false;
         if (cullBloom && p["id"] == "composite") p["inputs"].erase("bloom");
+        if (!keepDirect && p["id"] == "composite") p["params"]["keep_direct"] = false;
     }
     return j.dump(2);
 }
@@ -299,6 +302,14 @@ int main(int argc, char** argv) {
         situations.push_back({.label = "one marble moving, the whole picture redrawn (--full-redraw)",
                               .pipelineText = pipeline, .sceneFile = oneMarble, .restSeconds = 1.0,
                               .fullRedraw = true, .warmFrames = 24});
+        // Time and the fire move: every pass runs on the whole picture, but composite
+        // recomputes the lamp's light only where the fire was and is (keep_direct).
+        const std::string fire = restingScene(o.scene, args.outDir, false, true);
+        situations.push_back({.label = "the fireballs moving, the rest asleep", .pipelineText = pipeline,
+                              .sceneFile = fire, .restSeconds = 1.0, .warmFrames = 24});
+        situations.push_back({.label = "the fireballs moving, the rest asleep, composite.keep_direct off",
+                              .pipelineText = editedPipeline(pipeline, false, false, false), .sceneFile = fire,
+                              .restSeconds = 1.0, .warmFrames = 24});
     }
     const std::vector<Outcome> outcomes = measureRounds(app, situations, args);
 
