@@ -160,7 +160,13 @@
 //   720²). Choose what runs with defines (ctx.program's .defines, one variant per case)
 //   or by drawing each variant over only what needs it, not with branches. Each texture
 //   lookup costs about a millisecond at 720²: a pass gets cheaper by fewer lookups a
-//   pixel, not by cheaper arithmetic. Measure with kiln-bench-render.
+//   pixel, not by cheaper arithmetic — and by narrower texels: an RGBA32F fetch cost
+//   3.5 ms where an RGBA16F one cost about 2. `discard` saves nothing (the rest of the
+//   shader runs), nor does a depth test that fails everywhere (a full-screen pass
+//   masked so still cost 2–3 ms). To draw part of the picture, draw only that part,
+//   in squares aligned to llvmpipe's 64-pixel tiles: it sets up every triangle again in
+//   each tile it touches (composite over 16-pixel squares: +3 to +5 ms). Measure with
+//   kiln-bench-render.
 //
 // GL STATE
 //   Before each pass the host resets: framebuffer 0 and the viewport to the output
