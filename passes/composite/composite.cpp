@@ -30,6 +30,10 @@ namespace {
 
 class Composite final : public kiln::Pass {
 public:
+    ~Composite() override {
+        if (countFence_) glDeleteSync(countFence_);
+    }
+
     kiln::PassDeclaration declare() const override {
         using namespace kiln;
         PassDeclaration d;
@@ -150,28 +154,37 @@ public:
         const kiln::PixelRect nearRect =
             nearField ? screenRect(ctx, glm::vec3(lamp), lamp.w + ctx.getFloat("lamp_near_field")) : kiln::PixelRect{};
         if (keep) {
-            if (!drawKeepingDirect(ctx, program, nearProgram, cachedProgram, nearRect)) return;
-        } else {
-            cacheKey_.reset();
-            if (!ctx.framebuffer({"color", "hdr"})) return;
-            // Where only bodies moved, only what they change (kiln/pass.hpp).
-            kiln::forEachRedrawRect(ctx, color.width, color.height, 0, [&] {
-                bindInputs(ctx, program);
-                ctx.drawFullscreenTriangle();
-            });
-            // The near field again, per pixel, over its screen rectangle only (within
-            // each rectangle to redraw).
-            if (nearField) {
-                glEnable(GL_SCISSOR_TEST);
-                for (const kiln::PixelRect& part : kiln::redrawRects(ctx, color.width, color.height, 0)) {
-                    const kiln::PixelRect r = intersect(nearRect, part);
-                    if (r.empty()) continue;
-                    glScissor(r.x, r.y, r.width, r.height);
-                    bindInputs(ctx, nearProgram);
-                    ctx.drawFullscreenTriangle();
-                }
-                glDisable(GL_SCISSOR_TEST);
+            const Kept kept = drawKeepingDirect(ctx, program, nearProgram, cachedProgram, nearRect);
+            if (kept == Kept::Failed) return;
+            if (kept == Kept::Drawn) {
+                kiln::gl::bindSamplerObject(program, "u_shadowMap", 0);
+                return;
             }
+            // Most of the picture moved: every pixel computed, nothing kept, by the
+            // variants that write no `direct`.
+            program = variant(false, 0, false);
+            nearProgram = nearField ? variant(true, 0, false) : 0;
+            if (!program || (nearField && !nearProgram)) return;
+        }
+        cacheKey_.reset();
+        if (!ctx.framebuffer({"color", "hdr"})) return;
+        // Where only bodies moved, only what they change (kiln/pass.hpp).
+        kiln::forEachRedrawRect(ctx, color.width, color.height, 0, [&] {
+            bindInputs(ctx, program);
+            ctx.drawFullscreenTriangle();
+        });
+        // The near field again, per pixel, over its screen rectangle only (within each
+        // rectangle to redraw).
+        if (nearField) {
+            glEnable(GL_SCISSOR_TEST);
+            for (const kiln::PixelRect& part : kiln::redrawRects(ctx, color.width, color.height, 0)) {
+                const kiln::PixelRect r = intersect(nearRect, part);
+                if (r.empty()) continue;
+                glScissor(r.x, r.y, r.width, r.height);
+                bindInputs(ctx, nearProgram);
+                ctx.drawFullscreenTriangle();
+            }
+            glDisable(GL_SCISSOR_TEST);
         }
         kiln::gl::bindSamplerObject(program, "u_shadowMap", 0);  // the host resets textures, not samplers
     }
@@ -250,12 +263,21 @@ private:
     }
 
     // keep_direct: which tiles moved (moved_tiles.comp, tile_lists.comp), the lamp's
-    // light recomputed and kept over those, the rest shaded from what was kept.
-    bool drawKeepingDirect(kiln::PassContext& ctx, GLuint program, GLuint nearProgram, GLuint cachedProgram,
+    // light recomputed and kept over those, the rest shaded from what was kept. When
+    // most of the picture moved at the last count, drawing it in tiles costs more than
+    // the whole (llvmpipe, 720²: all tiles recomputed 22 ms, the plain pass 20; 50
+    // fireballs' particles move over 80 % of the tiles): DrawWhole, and the tiles are
+    // only counted.
+    enum class Kept { Drawn, DrawWhole, Failed };
+    Kept drawKeepingDirect(kiln::PassContext& ctx, GLuint program, GLuint nearProgram, GLuint cachedProgram,
                            const kiln::PixelRect& nearRect) {
-        GLuint moved = ctx.program({.stages = {"composite/moved_tiles.comp"}});
+        GLuint marking[3];  // moved_tiles.comp's parts: the casters, the other instances, what lies in shadows
+        for (int part = 0; part < 3; ++part)
+            if (!(marking[part] = ctx.program({.stages = {"composite/moved_tiles.comp"},
+                                               .defines = {{"KILN_PART", std::to_string(part)}}})))
+                return Kept::Failed;
         GLuint lists = ctx.program({.stages = {"composite/tile_lists.comp"}});
-        if (!moved || !lists) return false;
+        if (!lists) return Kept::Failed;
         const kiln::SceneView& scene = ctx.scene();
         const kiln::TextureRef& color = ctx.output("color");
         const int tileSize = ctx.getInt("direct_tile");
@@ -264,17 +286,29 @@ private:
         const uint32_t tileCount = uint32_t(tilesAcross * tilesDown);
         const uint32_t first = scene.firstInstance(kiln::kSceneTumblers), end = scene.count(kiln::kSceneGeometry);
 
+        // The share of the tiles that moved at the last count the GPU has finished.
+        if (countFence_ && glClientWaitSync(countFence_, 0, 0) != GL_TIMEOUT_EXPIRED) {
+            uint32_t movedTiles = 0;
+            glGetNamedBufferSubData(movedCount_.id(), 0, sizeof movedTiles, &movedTiles);
+            movedShare_ = countedTiles_ ? double(movedTiles) / countedTiles_ : 0.0;
+            glDeleteSync(countFence_);
+            countFence_ = nullptr;
+        }
+        // Back from the whole at a lower share than away to it: the first run in tiles
+        // recomputes them all.
+        const bool inTiles = movedShare_ <= (drawingWhole_ ? kTilesBackBelow : kTilesUpTo);
+        drawingWhole_ = !inTiles;
+
         const CacheKey key = cacheKey(ctx, program, nearProgram);
-        bool reuse = cacheKey_ && *cacheKey_ == key;
+        bool reuse = inTiles && cacheKey_ && *cacheKey_ == key;
         cacheKey_.reset();  // set again once this run has drawn
         if (!previous_ || previous_.size() < GLsizeiptr(end * sizeof(kiln::GpuInstance))) {
             const GLsizeiptr bytes = GLsizeiptr(std::max<uint32_t>(2 * end, 64) * sizeof(kiln::GpuInstance));
             previous_ = kiln::gl::Buffer::create(bytes, nullptr, 0, "composite.previous_instances");
+            previousKept_ = false;
             reuse = false;
         }
-        const uint32_t previousEnd = reuse ? previousEnd_ : 0;
-        previousEnd_ = end;
-        const GLsizeiptr listBytes = GLsizeiptr((8 + 2 * tileCount) * sizeof(uint32_t));
+        const GLsizeiptr listBytes = GLsizeiptr((kListsStart + 2 * tileCount) * sizeof(uint32_t));
         if (tileLists_.size() != listBytes) {
             tileLists_ = kiln::gl::Buffer::create(listBytes, nullptr, GL_DYNAMIC_STORAGE_BIT, "composite.tile_lists");
             const std::vector<uint32_t> zeros(tileCount, 0u);
@@ -284,38 +318,60 @@ private:
         }
         auto uniform = [](GLuint p, const char* name) { return glGetUniformLocation(p, name); };
 
-        // Which tiles instances moving since the last run can have changed.
-        glUseProgram(moved);
-        kiln::gl::bindStorageBuffer(moved, "PreviousInstances", previous_.id());
-        kiln::gl::bindStorageBuffer(moved, "TileMarks", tileMarks_.id());
-        glUniform1ui(uniform(moved, "u_first"), first);
-        glUniform1ui(uniform(moved, "u_end"), end);
-        glUniform1ui(uniform(moved, "u_previousEnd"), previousEnd);
-        glUniform1ui(uniform(moved, "u_tumblersEnd"), first + scene.count(kiln::kSceneTumblers));
-        glUniform1ui(uniform(moved, "u_castersEnd"), first + scene.count(kiln::kSceneShadowCasters));
-        glUniform1i(uniform(moved, "u_markAll"), reuse ? 0 : 1);
-        glUniform2i(uniform(moved, "u_tiles"), tilesAcross, tilesDown);
-        glUniform1i(uniform(moved, "u_tileSize"), tileSize);
-        // The filter's farthest lookup is (k+1)/2 − 1 texels off the pixel's point, and
-        // each is bilinear: one texel more; one more for rounding.
-        glUniform1f(uniform(moved, "u_shadowReachTexels"), float((ctx.getInt("pcf") + 1) / 2 + 1));
+        // Which tiles instances moving since the last run can have changed: the movers
+        // (and the casters' pyramids), then what lies in those.
+        const uint32_t casters = scene.count(kiln::kSceneShadowCasters);
+        const GLsizeiptr pyramidBytes = GLsizeiptr(16 + 2 * 2 * std::max<uint32_t>(casters, 1) * 16);
+        if (pyramids_.size() != pyramidBytes)
+            pyramids_ = kiln::gl::Buffer::create(pyramidBytes, nullptr, GL_DYNAMIC_STORAGE_BIT, "composite.shadow_pyramids");
+        const uint32_t none = 0;
+        glNamedBufferSubData(pyramids_.id(), 0, sizeof none, &none);
         const kiln::TextureRef& shadow = ctx.input("shadow_map");
-        glUniform2f(uniform(moved, "u_shadowTexel"), shadow.bound ? 1.0f / float(shadow.width) : 0.0f,
-                    shadow.bound ? 1.0f / float(shadow.height) : 0.0f);
-        const uint32_t compared = std::max(end, previousEnd);
-        if (compared > first) glDispatchCompute((compared - first + 63) / 64, 1, 1);
-        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        const uint32_t compared = std::max(end, previousKept_ ? previousEnd_ : 0u);
+        const uint32_t castersEnd = first + casters;
+        const uint32_t from[3] = {first, castersEnd, first}, to[3] = {castersEnd, compared, end};
+        for (int part = 0; part < 3; ++part) {
+            const GLuint p = marking[part];
+            glUseProgram(p);
+            kiln::gl::bindStorageBuffer(p, "PreviousInstances", previous_.id());
+            kiln::gl::bindStorageBuffer(p, "TileMarks", tileMarks_.id());
+            kiln::gl::bindStorageBuffer(p, "ShadowPyramids", pyramids_.id());
+            glUniform1ui(uniform(p, "u_from"), from[part]);
+            glUniform1ui(uniform(p, "u_to"), to[part]);
+            glUniform1ui(uniform(p, "u_end"), end);
+            glUniform1ui(uniform(p, "u_previousEnd"), previousKept_ ? previousEnd_ : 0u);
+            glUniform1ui(uniform(p, "u_tumblersEnd"), first + scene.count(kiln::kSceneTumblers));
+            glUniform1i(uniform(p, "u_compare"), previousKept_ ? 1 : 0);
+            glUniform2i(uniform(p, "u_tiles"), tilesAcross, tilesDown);
+            glUniform1i(uniform(p, "u_tileSize"), tileSize);
+            // The filter's farthest lookup is (k+1)/2 − 1 texels off the pixel's point,
+            // and each is bilinear: one texel more; one more for rounding.
+            glUniform1f(uniform(p, "u_shadowReachTexels"), float((ctx.getInt("pcf") + 1) / 2 + 1));
+            glUniform2f(uniform(p, "u_shadowTexel"), shadow.bound ? 1.0f / float(shadow.width) : 0.0f,
+                        shadow.bound ? 1.0f / float(shadow.height) : 0.0f);
+            if (to[part] > from[part]) glDispatchCompute((to[part] - from[part] + 63) / 64, 1, 1);
+            glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        }
+        previousEnd_ = end, previousKept_ = true;
 
-        // The two lists: their draw commands (vertices counted on the GPU, one instance).
-        const uint32_t commands[8] = {0, 1, 0, 0, 0, 1, 0, 0};
-        glNamedBufferSubData(tileLists_.id(), 0, sizeof commands, commands);
+        // The two lists: their draw commands (vertices counted on the GPU, one instance)
+        // and the count of moved tiles, read back a run later.
+        const uint32_t header[kListsStart] = {0, 1, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0};
+        glNamedBufferSubData(tileLists_.id(), 0, sizeof header, header);
         glUseProgram(lists);
         kiln::gl::bindStorageBuffer(lists, "TileMarks", tileMarks_.id());
         kiln::gl::bindStorageBuffer(lists, "TileLists", tileLists_.id());
         glUniform1ui(uniform(lists, "u_tileCount"), tileCount);
         glUniform1i(uniform(lists, "u_all"), reuse ? 0 : 1);
         glDispatchCompute((tileCount + 63) / 64, 1, 1);
-        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+        if (!countFence_) {
+            if (!movedCount_) movedCount_ = kiln::gl::Buffer::create(sizeof(uint32_t), nullptr, 0, "composite.moved_tiles");
+            glCopyNamedBufferSubData(tileLists_.id(), movedCount_.id(), 8 * sizeof(uint32_t), 0, sizeof(uint32_t));
+            countFence_ = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
+            countedTiles_ = tileCount;
+        }
+        if (!inTiles) return Kept::DrawWhole;
 
         if (!vertexArray_) vertexArray_ = kiln::gl::createVertexArray();
         glBindVertexArray(vertexArray_.id());
@@ -323,14 +379,14 @@ private:
         auto drawList = [&](GLuint p, bool recomputed) {
             bindInputs(ctx, p);
             kiln::gl::bindStorageBuffer(p, "TileLists", tileLists_.id());
-            glUniform1ui(uniform(p, "u_listStart"), recomputed ? 8u : 8u + tileCount);
+            glUniform1ui(uniform(p, "u_listStart"), kListsStart + (recomputed ? 0u : tileCount));
             glUniform1i(uniform(p, "u_tileSize"), tileSize);
             glUniform1i(uniform(p, "u_tilesAcross"), tilesAcross);
             glDrawArraysIndirect(GL_TRIANGLES, reinterpret_cast<const void*>(recomputed ? 0 : 4 * sizeof(uint32_t)));
         };
         // The moved tiles, whole (the kept light must be right everywhere, whatever
         // the frame asks to redraw), and the near field again over its rectangle.
-        if (!ctx.framebuffer({"color", "hdr", "direct"})) return false;
+        if (!ctx.framebuffer({"color", "hdr", "direct"})) return Kept::Failed;
         drawList(program, true);
         if (nearProgram && !nearRect.empty()) {
             glEnable(GL_SCISSOR_TEST);
@@ -340,12 +396,12 @@ private:
         }
         // The rest from the kept light (where only bodies moved, within the rectangles
         // the frame redraws: kiln/pass.hpp).
-        if (!ctx.framebuffer({"color", "hdr"})) return false;
+        if (!ctx.framebuffer({"color", "hdr"})) return Kept::Failed;
         kiln::forEachRedrawRect(ctx, color.width, color.height, 0, [&] { drawList(cachedProgram, false); });
         glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
         glBindVertexArray(0);
         cacheKey_ = key;
-        return true;
+        return Kept::Drawn;
     }
 
     // lamp_model field: the grid (the pass's own texture, made only in this mode: 1 MiB
@@ -393,11 +449,22 @@ private:
     kiln::gl::SamplerHandle compareSampler_;
 
     // keep_direct (the pass's own objects: a reload starts over).
+    static constexpr uint32_t kListsStart = 12;  // tile_lists.comp: two draw commands and a count first
+    // The share of moved tiles above which the whole is drawn (llvmpipe at 720²: in tiles
+    // 11.7 ms + 10.4 × the share, whole 20), and below which tiles come back.
+    static constexpr double kTilesUpTo = 0.75, kTilesBackBelow = 0.6;
+    bool drawingWhole_ = false;
     std::optional<CacheKey> cacheKey_;      // what the kept light was computed from; empty: nothing kept
     kiln::gl::Buffer previous_;             // the instances at the last run
     uint32_t previousEnd_ = 0;              // how many there were
+    bool previousKept_ = false;
     kiln::gl::Buffer tileMarks_;            // one a tile: moved_tiles.comp marks, tile_lists.comp clears
-    kiln::gl::Buffer tileLists_;            // two draw commands, then the tiles to recompute and the rest
+    kiln::gl::Buffer tileLists_;            // two draw commands, the moved count, the two lists
+    kiln::gl::Buffer pyramids_;             // the moved casters' shadow pyramids (moved_tiles.comp)
+    kiln::gl::Buffer movedCount_;           // the count copied out, read once the GPU is past it
+    GLsync countFence_ = nullptr;
+    uint32_t countedTiles_ = 0;
+    double movedShare_ = 0.0;               // of the tiles at the last count read
     kiln::gl::VertexArrayHandle vertexArray_;
 };
 
