@@ -4,9 +4,10 @@
 // `hdr` is the radiance estimate before bloom and exposure, the image the error
 // metrics compare with the reference.
 // KILN_DIRECT: 0 computes the lamp's light here; 1 does and also writes it to `direct`
-// (the pass's cache: everything that depends only on the G-buffer, the shadow map and
-// the lamp, as halves; alpha the frame that computed it); 2 reads it from there. 1 and 2 shade from it by the same function, so a
-// pixel comes out the same whichever drew it (composite.cpp, keep_direct).
+// (the pass's cache of what depends only on the G-buffer, the shadow map and the lamp;
+// alpha the frame that computed it); 2 reads it from there. All three shade from the
+// light as `direct` keeps it (asKept), by one function: a pixel comes out the same
+// whichever drew it, and with keep_direct off (composite.cpp).
 #include "common/frame.glsl"
 #include "common/light.glsl"
 #include "common/shadow.glsl"
@@ -184,8 +185,9 @@ vec3 shade(ivec2 px, vec2 uv, vec3 lampLit, vec3 albedo) {
 // as 0 (a render target may flush what packHalf2x16 keeps). Every variant shades from
 // it so, whether it computed the light or read it back: the picture is the same
 // with keep_direct on or off (the hdr output is halves too).
-// Rounded to 11 significant bits, to nearest even, by integer steps (packHalf2x16 and
-// back cost more on llvmpipe); the light is ≥ 0 and far below the largest half.
+// Rounded to 11 significant bits, to nearest even, by integer steps: what
+// packHalf2x16 and back give (the picture identical both ways), for a light ≥ 0 and
+// far below the largest half.
 vec3 asKept(vec3 light) {
     uvec3 bits = floatBitsToUint(light);
     bits = (bits + 0xFFFu + ((bits >> 13) & 1u)) & ~0x1FFFu;

@@ -28,6 +28,14 @@ using namespace kiln;
 
 namespace {
 
+// The default pipeline with `params` set on its composite pass.
+nlohmann::json defaultWithComposite(const nlohmann::json& params) {
+    nlohmann::json p = nlohmann::json::parse(std::ifstream(KILN_SOURCE_DIR "/pipelines/default.json"));
+    for (auto& pass : p["passes"])
+        if (pass["id"] == "composite") pass["params"].update(params);
+    return p;
+}
+
 // The shipped lamp (scenes/cornell.json): sphere (0, 1.1, 0), radius 0.35, below y = 1.
 const glm::dvec3 kLampCentre(0.0, 1.1, 0.0);
 const double kLampRadius = 0.35, kCeiling = 1.0;
@@ -262,13 +270,8 @@ TEST_CASE("lamp: from its field (one lookup a pixel), the lamp's light is the pe
     // 17 % and 8.6 %).
     test::Rig rig(KILN_SOURCE_DIR "/scenes/cornell.json", 96);
     auto direct = [&](const std::string& model) {
-        nlohmann::json p = nlohmann::json::parse(std::ifstream(KILN_SOURCE_DIR "/pipelines/default.json"));
-        for (auto& pass : p["passes"])
-            if (pass["id"] == "composite") {
-                pass["params"]["lamp_model"] = model;
-                pass["params"]["indirect_strength"] = 0.0;
-            }
-        rig.load(p.dump(), {"composite.hdr", "gbuffer.depth", "gbuffer.normal"});
+        rig.load(defaultWithComposite({{"lamp_model", model}, {"indirect_strength", 0.0}}).dump(),
+                 {"composite.hdr", "gbuffer.depth", "gbuffer.normal"});
         rig.app.frame();
         rig.checkNoErrors();
         return rig.image("composite", "hdr");
@@ -374,13 +377,8 @@ TEST_CASE("lamp: traced at one pixel in 4×4 and upsampled, the lamp's light sta
 namespace {
 // The default pipeline with composite's keep_direct on or off, in 16-pixel tiles.
 void loadKeepingDirect(test::Rig& rig, bool keep) {
-    nlohmann::json p = nlohmann::json::parse(std::ifstream(KILN_SOURCE_DIR "/pipelines/default.json"));
-    for (auto& pass : p["passes"])
-        if (pass["id"] == "composite") {
-            pass["params"]["keep_direct"] = keep;
-            pass["params"]["direct_tile"] = 16;
-        }
-    rig.load(p.dump(), {"composite.hdr", "composite.color", "composite.direct"});
+    rig.load(defaultWithComposite({{"keep_direct", keep}, {"direct_tile", 16}}).dump(),
+             {"composite.hdr", "composite.color", "composite.direct"});
 }
 
 // Values of composite's `output` that differ between two rigs.
