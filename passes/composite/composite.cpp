@@ -311,6 +311,10 @@ private:
         const GLsizeiptr listBytes = GLsizeiptr((kListsStart + 2 * tileCount) * sizeof(uint32_t));
         if (tileLists_.size() != listBytes) {
             tileLists_ = kiln::gl::Buffer::create(listBytes, nullptr, GL_DYNAMIC_STORAGE_BIT, "composite.tile_lists");
+            GLuint texture = 0;
+            glCreateTextures(GL_TEXTURE_BUFFER, 1, &texture);
+            glTextureBuffer(texture, GL_R32UI, tileLists_.id());
+            tileListsTexture_ = kiln::gl::TextureHandle(texture);
             const std::vector<uint32_t> zeros(tileCount, 0u);
             tileMarks_ = kiln::gl::Buffer::create(GLsizeiptr(tileCount * sizeof(uint32_t)), zeros.data(), 0,
                                                   "composite.tile_marks");
@@ -364,7 +368,8 @@ private:
         glUniform1ui(uniform(lists, "u_tileCount"), tileCount);
         glUniform1i(uniform(lists, "u_all"), reuse ? 0 : 1);
         glDispatchCompute((tileCount + 63) / 64, 1, 1);
-        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT |
+                        GL_TEXTURE_FETCH_BARRIER_BIT);  // tiles.vert reads the lists as a buffer texture
         if (!countFence_) {
             if (!movedCount_) movedCount_ = kiln::gl::Buffer::create(sizeof(uint32_t), nullptr, 0, "composite.moved_tiles");
             glCopyNamedBufferSubData(tileLists_.id(), movedCount_.id(), 8 * sizeof(uint32_t), 0, sizeof(uint32_t));
@@ -378,7 +383,7 @@ private:
         glBindBuffer(GL_DRAW_INDIRECT_BUFFER, tileLists_.id());
         auto drawList = [&](GLuint p, bool recomputed) {
             bindInputs(ctx, p);
-            kiln::gl::bindStorageBuffer(p, "TileLists", tileLists_.id());
+            kiln::gl::bindTexture(p, "u_tileLists", tileListsTexture_.id());
             glUniform1ui(uniform(p, "u_listStart"), kListsStart + (recomputed ? 0u : tileCount));
             glUniform1i(uniform(p, "u_tileSize"), tileSize);
             glUniform1i(uniform(p, "u_tilesAcross"), tilesAcross);
@@ -460,6 +465,7 @@ private:
     bool previousKept_ = false;
     kiln::gl::Buffer tileMarks_;            // one a tile: moved_tiles.comp marks, tile_lists.comp clears
     kiln::gl::Buffer tileLists_;            // two draw commands, the moved count, the two lists
+    kiln::gl::TextureHandle tileListsTexture_;  // the same as a buffer texture (tiles.vert)
     kiln::gl::Buffer pyramids_;             // the moved casters' shadow pyramids (moved_tiles.comp)
     kiln::gl::Buffer movedCount_;           // the count copied out, read once the GPU is past it
     GLsync countFence_ = nullptr;

@@ -85,6 +85,7 @@ void deleteQuery(GLuint);
 void deleteSampler(GLuint);
 }  // namespace detail
 
+using TextureHandle = Handle<detail::deleteTexture>;  // a texture kiln::gl::Texture does not make (a buffer texture)
 using BufferHandle = Handle<detail::deleteBuffer>;
 using FramebufferHandle = Handle<detail::deleteFramebuffer>;
 using VertexArrayHandle = Handle<detail::deleteVertexArray>;
