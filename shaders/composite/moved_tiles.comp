@@ -41,15 +41,22 @@ void markPixels(vec2 lo, vec2 hi) {  // pixel coordinates, inclusive bounds grow
 
 void markEverything() { markPixels(vec2(0.0), vec2(u_tiles * u_tileSize)); }
 
-// The screen rectangle of a world box: its corners projected.
-void markWorldBox(vec3 lo, vec3 hi) {
-    vec2 a = vec2(1e30), b = vec2(-1e30);
+// The rectangle [a, b] in normalized device coordinates that a world box's corners
+// project to through `toClip`; false when one of them lies behind its eye.
+bool projectBox(mat4 toClip, vec3 lo, vec3 hi, out vec2 a, out vec2 b) {
+    a = vec2(1e30), b = vec2(-1e30);
     for (int i = 0; i < 8; ++i) {
-        vec3 corner = mix(lo, hi, vec3(i & 1, (i >> 1) & 1, (i >> 2) & 1));
-        vec4 clip = u_viewProj * vec4(corner, 1.0);
-        if (clip.w <= 1e-4) { markEverything(); return; }
+        vec4 clip = toClip * vec4(mix(lo, hi, vec3(i & 1, (i >> 1) & 1, (i >> 2) & 1)), 1.0);
+        if (clip.w <= 1e-4) return false;
         a = min(a, clip.xy / clip.w), b = max(b, clip.xy / clip.w);
     }
+    return true;
+}
+
+// The screen rectangle of a world box.
+void markWorldBox(vec3 lo, vec3 hi) {
+    vec2 a, b;
+    if (!projectBox(u_viewProj, lo, hi, a, b)) { markEverything(); return; }
     markPixels((clamp(a, -1.0, 1.0) * 0.5 + 0.5) * u_outputSize.xy, (clamp(b, -1.0, 1.0) * 0.5 + 0.5) * u_outputSize.xy);
 }
 
@@ -103,12 +110,8 @@ void markWallInPyramid(int axis, float side) {
 
 void markShadow(vec3 lo, vec3 hi) {
     mat4 toMap = lightViewProj();
-    vec2 a = vec2(1e30), b = vec2(-1e30);
-    for (int i = 0; i < 8; ++i) {
-        vec4 clip = toMap * vec4(mix(lo, hi, vec3(i & 1, (i >> 1) & 1, (i >> 2) & 1)), 1.0);
-        if (clip.w <= 1e-4) { markEverything(); return; }
-        a = min(a, clip.xy / clip.w), b = max(b, clip.xy / clip.w);
-    }
+    vec2 a, b;
+    if (!projectBox(toMap, lo, hi, a, b)) { markEverything(); return; }
     vec2 reach = 2.0 * u_shadowReachTexels * u_shadowTexel;  // texels in the map's [-1, 1]
     a -= reach, b += reach;
     mat4 fromMap = inverse(toMap);

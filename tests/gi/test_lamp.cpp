@@ -381,6 +381,13 @@ void loadKeepingDirect(test::Rig& rig, bool keep) {
              {"composite.hdr", "composite.color", "composite.direct"});
 }
 
+// The newest frame composite's kept light was computed in: its alpha's largest value.
+float newestKeptFrame(const FloatImage& direct) {
+    float newest = 0.0f;
+    for (size_t i = 3; i < direct.pixels.size(); i += 4) newest = std::max(newest, direct.pixels[i]);
+    return newest;
+}
+
 // Values of composite's `output` that differ between two rigs.
 size_t differingValues(test::Rig& a, test::Rig& b, const char* output) {
     const FloatImage x = a.image("composite", output), y = b.image("composite", output);
@@ -410,8 +417,7 @@ TEST_CASE("composite keep_direct: the lamp's light kept and recomputed where ins
     // Tiles the last run recomputed: their kept light's alpha is the newest frame's.
     auto recomputedTiles = [&] {
         const FloatImage direct = kept.image("composite", "direct");
-        float newest = 0.0f;
-        for (size_t i = 3; i < direct.pixels.size(); i += 4) newest = std::max(newest, direct.pixels[i]);
+        const float newest = newestKeptFrame(direct);
         int tiles = 0;
         for (int ty = 0; ty < 8; ++ty)
             for (int tx = 0; tx < 8; ++tx) tiles += direct.at(tx * 16, ty * 16)[3] == newest;
@@ -519,8 +525,7 @@ TEST_CASE("composite keep_direct: where most of the picture moves it is drawn wh
         worst = std::max(worst, differingValues(kept, whole, "hdr"));
         // The kept light's alpha: the frame that computed it.
         const FloatImage direct = kept.image("composite", "direct");
-        float newest = 0.0f;
-        for (size_t i = 3; i < direct.pixels.size(); i += 4) newest = std::max(newest, direct.pixels[i]);
+        const float newest = newestKeptFrame(direct);
         size_t atNewest = 0;
         for (size_t i = 3; i < direct.pixels.size(); i += 4) atNewest += direct.pixels[i] == newest;
         drawnWhole += newest == lastNewest;
