@@ -265,6 +265,25 @@ std::vector<uint64_t> Runtime::runKey(const graph::PlannedPass& planned, const P
     return key;
 }
 
+namespace {
+// Whether this run's key differs from the last run's (runKey: the inputs' versions, the
+// scene categories, the output size, the programs) only in scene categories of
+// `categories` and in inputs `inputExplained(k)` accepts; never for a pass that reads
+// time or did not run last time (or failed).
+template <class InputExplained>
+bool changedOnlyIn(const graph::PlannedPass& planned, const std::optional<std::vector<uint64_t>>& lastKey,
+                   const std::vector<uint64_t>& key, uint32_t categories, InputExplained&& inputExplained) {
+    if (planned.decl.timeDependent || !lastKey || lastKey->size() != key.size()) return false;
+    const size_t inputs = planned.bindings.size(), scene = inputs + kSceneCategoryCount;
+    for (size_t k = 0; k < key.size(); ++k) {
+        if (key[k] == (*lastKey)[k]) continue;
+        if (k >= scene) return false;  // the output size or the programs
+        if (k >= inputs ? !((1u << (k - inputs)) & categories) : !inputExplained(k)) return false;
+    }
+    return true;
+}
+}  // namespace
+
 // Whether the only reasons this pass runs are bodies moving (kiln/pass.hpp, REDRAWING
 // PART OF THE PICTURE): the frame says only bodies moved, the pass ran last time, and
 // what differs from that run's key is scene categories it reads (not time) or inputs
@@ -273,19 +292,11 @@ std::vector<uint64_t> Runtime::runKey(const graph::PlannedPass& planned, const P
 // reason: everything.
 bool Runtime::runsForBodiesOnly(const graph::PlannedPass& planned, const PassSlot& slot,
                                 const std::vector<uint64_t>& key, bool settling, const FrameInfo& frame) const {
-    if (frame.redrawCount == 0 || settling || planned.decl.timeDependent || !slot.lastRunKey ||
-        slot.lastRunKey->size() != key.size())
-        return false;
-    const std::vector<uint64_t>& last = *slot.lastRunKey;
-    const size_t inputs = planned.bindings.size(), scene = inputs + kSceneCategoryCount;
-    const size_t time = inputs + size_t(sceneCategoryIndex(kSceneTime));
-    for (size_t k = 0; k < key.size(); ++k) {
-        if (key[k] == last[k] || (k >= inputs && k < scene && k != time)) continue;
-        if (k >= scene) return false;  // the output size or the programs
-        const graph::Binding& b = planned.bindings[k];
-        if (!b.bound() || !slots_[static_cast<size_t>(b.producer)]->lastRunByScene) return false;
-    }
-    return true;
+    return frame.redrawCount > 0 && !settling &&
+           changedOnlyIn(planned, slot.lastRunKey, key, kSceneAll & ~kSceneTime, [&](size_t k) {
+               const graph::Binding& b = planned.bindings[k];
+               return b.bound() && slots_[static_cast<size_t>(b.producer)]->lastRunByScene;
+           });
 }
 
 // Whether this run's outputs differ from the last run's only through instances moving
@@ -294,22 +305,10 @@ bool Runtime::runsForBodiesOnly(const graph::PlannedPass& planned, const PassSlo
 // instance categories it reads or inputs whose setup is what it was then.
 bool Runtime::changedOnlyByInstances(const graph::PlannedPass& planned, const PassSlot& slot,
                                      const std::vector<uint64_t>& key, bool converging) const {
-    constexpr uint32_t kInstanceCategories = kSceneBodies | kSceneParticles;
-    if (converging || planned.decl.timeDependent || !slot.lastRunKey || slot.lastRunKey->size() != key.size() ||
-        slot.inputSetups.size() != planned.bindings.size())
-        return false;
-    const std::vector<uint64_t>& last = *slot.lastRunKey;
-    const size_t inputs = planned.bindings.size(), scene = inputs + kSceneCategoryCount;
-    for (size_t k = 0; k < key.size(); ++k) {
-        if (key[k] == last[k]) continue;
-        if (k >= scene) return false;  // the output size or the programs
-        if (k >= inputs) {
-            if (!((1u << (k - inputs)) & kInstanceCategories)) return false;
-        } else if (inputSetup(planned.bindings[k]) != slot.inputSetups[k]) {
-            return false;
-        }
-    }
-    return true;
+    return !converging && slot.inputSetups.size() == planned.bindings.size() &&
+           changedOnlyIn(planned, slot.lastRunKey, key, kSceneBodies | kSceneParticles, [&](size_t k) {
+               return inputSetup(planned.bindings[k]) == slot.inputSetups[k];
+           });
 }
 
 uint64_t Runtime::inputSetup(const graph::Binding& b) const {
