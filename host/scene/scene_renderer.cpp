@@ -85,7 +85,7 @@ void SceneRenderer::setLook(const SceneLook& look) {
 }
 
 void SceneRenderer::noteContents(SceneCategory c, const GpuInstance* begin, size_t count) {
-    const uint64_t h = fnv1a(begin, count * sizeof(GpuInstance), fnv1a(&count, sizeof count));
+    const uint64_t h = hashWords(begin, count * sizeof(GpuInstance), fnv1a(&count, sizeof count));
     const int k = sceneCategoryIndex(c);
     counts_[k] = static_cast<uint32_t>(count);
     if (h != hashes_[k]) hashes_[k] = h, ++versions_[k];
