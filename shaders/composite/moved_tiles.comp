@@ -82,7 +82,7 @@ void instanceBox(KilnInstance inst, bool tumbler, out vec3 lo, out vec3 hi) {
 // lit either way). The walls there: for each wall, the pyramid's part within 1 cm of
 // it, bounded by where its edges cross that slab and its corners inside it. The
 // instances there, wherever they are: each one's own box, but those of no albedo (the
-// particles: no lamp light to change), in a second dispatch (KILN_RECEIVERS) against
+// particles: no lamp light to change), in a second dispatch (KILN_PART 2) against
 // the pyramids' boxes this one records. The dome, if the pyramid reaches it.
 vec3 pyramid[8];  // corners: i & 3 the ray, i >> 2 top (0) or bottom (1)
 const ivec2 kPyramidEdges[12] = ivec2[](ivec2(0, 1), ivec2(1, 3), ivec2(3, 2), ivec2(2, 0), ivec2(4, 5), ivec2(5, 7),
@@ -133,7 +133,7 @@ void markShadow(vec3 lo, vec3 hi) {
     if (top > u_lightPos.y - u_lightPos.w) markWorldBox(u_lightPos.xyz - u_lightPos.w, u_lightPos.xyz + u_lightPos.w);
     for (int wall = 0; wall < 6; ++wall)
         if ((u_boxWalls.x & (1u << wall)) != 0u) markWallInPyramid(wall >> 1, (wall & 1) == 0 ? -1.0 : 1.0);
-    // The instances inside: each tests the recorded pyramids (KILN_RECEIVERS).
+    // The instances inside: each tests the recorded pyramids (KILN_PART 2).
     uint k = atomicAdd(pyramidCount, 1u);
     if (k < pyramidBoxes.length() / 2) pyramidBoxes[2u * k] = vec4(boxLo, 0.0), pyramidBoxes[2u * k + 1u] = vec4(boxHi, 0.0);
     else markEverything();
