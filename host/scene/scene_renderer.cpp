@@ -12,13 +12,17 @@
 namespace kiln::scene {
 
 void SceneRenderer::buildMeshes(const SceneLook& look) {
+    auto tumbler = [&](const TumblerMesh& m) {
+        return makeTumbler(look.tumblerB, look.tumblerT, look.tumblerAlpha, m.slices, m.stacks,
+                           m.inflated ? areaPreservingInflation(look.tumblerB, m.slices) : 0.0f);
+    };
     std::array<MeshData, kMeshCount> data = {
         makeQuad(),
         makeLampDome(look.lampCentre, look.lampRadius, 3, 1.0f),
-        makeTumbler(look.tumblerB, look.tumblerT, look.tumblerAlpha, 48, 16),  // the camera's,
-        makeTumbler(look.tumblerB, look.tumblerT, look.tumblerAlpha, 24, 8,  // Lod::Medium (the shadow map:
-                    areaPreservingInflation(look.tumblerB, 24)),             // a shadow as large as the round one),
-        makeTumbler(look.tumblerB, look.tumblerT, look.tumblerAlpha, 12, 4),   // Lod::Low (voxelization)
+        tumbler(kTumblerNear),    // the camera's near,
+        tumbler(kTumblerFar),     // far,
+        tumbler(kTumblerShadow),  // Lod::Medium (the shadow map),
+        tumbler(kTumblerVoxels),  // Lod::Low (voxelization)
         makeUvSphere(kSphereSegments[0], 16),  // spheres by size on screen (sphereLevelFor): near,
         makeUvSphere(kSphereSegments[1], 8),   // mid,
         makeUvSphere(kSphereSegments[2], 6),   // far, and for voxelization
@@ -74,8 +78,7 @@ void SceneRenderer::setLook(const SceneLook& look) {
     staticInstances_.push_back(
         {I, glm::vec4(look.lampColor, 0.0f), glm::vec4(look.lampColor * look.lampIntensity, 0.0f)});
     // The tumbler's mesh about its origin (the lower ball's centre): the upper ball's top.
-    const float upperCentre = (look.tumblerB - look.tumblerT) / std::sin(look.tumblerAlpha);
-    tumblerRadius_ = std::max(look.tumblerB, upperCentre + look.tumblerT) * 1.05f;
+    tumblerRadius_ = tumblerBoundingRadius(look.tumblerB, look.tumblerT, look.tumblerAlpha);
     movedUnbounded_ = true;
     // New meshes change what every category looks like, whatever its instances say.
     for (int i = 0; i < kSceneGeometryCount; ++i) ++versions_[i], hashes_[i] = 0;
@@ -152,12 +155,22 @@ void SceneRenderer::setViewer(glm::vec3 eye, float pixelsPerUnit) {
 
 // At a third of the triangles for the usual 20–40-px marble (measured: 100 marbles at
 // 720² cost 1.21× the 3-marble frame with one 24-segment mesh, 1.08× with these).
-void SceneRenderer::sortSpheresBySize() {
+void SceneRenderer::chooseLevels() {
     size_t first = 0;
     int k = 0;
     for (SceneCategory c : {kSceneTumblers, kSceneMarbles, kSceneFireballs}) {
         const size_t n = count(c);
-        if (c != kSceneTumblers) {
+        if (c == kSceneTumblers) {
+            // One mesh for all: the largest on screen decides.
+            float largestPx = 0.0f;
+            for (size_t i = first; i < first + n; ++i) {
+                const GpuInstance& g = bodyInstances_[i];
+                const float scale = glm::length(glm::vec3(g.model[1]));
+                const float distance = std::max(glm::length(glm::vec3(g.model[3]) - eye_), 1e-3f);
+                largestPx = std::max(largestPx, tumblerRadius_ * scale / distance * pixelsPerUnit_);
+            }
+            tumblersNear_ = largestPx >= kTumblerNearPx;
+        } else {
             auto level = [&](const GpuInstance& g) {
                 const float radius = glm::length(glm::vec3(g.model[0]));
                 const float distance = std::max(glm::length(glm::vec3(g.model[3]) - eye_), 1e-3f);
@@ -189,6 +202,7 @@ void SceneRenderer::rebuildGroups() {
             at += levels[size_t(i)];
         }
         if (count(cat) > 0) {
+            groups_.push_back({kSphereHigh, cat, Lod::Fine, false, cursor, count(cat)});
             groups_.push_back({kSphereMid, cat, Lod::Medium, false, cursor, count(cat)});
             groups_.push_back({kSphereLow, cat, Lod::Low, false, cursor, count(cat)});
         }
@@ -199,7 +213,8 @@ void SceneRenderer::rebuildGroups() {
     add(kQuad, kSceneBox);
     add(kLamp, kSceneLamp);
     if (const uint32_t n = count(kSceneTumblers); n > 0) {
-        groups_.push_back({kTumblerHigh, kSceneTumblers, Lod::High, false, cursor, n});
+        groups_.push_back({tumblersNear_ ? kTumblerHigh : kTumblerFarMesh, kSceneTumblers, Lod::High, false, cursor, n});
+        groups_.push_back({kTumblerHigh, kSceneTumblers, Lod::Fine, false, cursor, n});
         groups_.push_back({kTumblerMid, kSceneTumblers, Lod::Medium, false, cursor, n});
         groups_.push_back({kTumblerLow, kSceneTumblers, Lod::Low, false, cursor, n});
         cursor += n;
@@ -211,7 +226,7 @@ void SceneRenderer::rebuildGroups() {
 
 void SceneRenderer::upload() {
     if (!dirty_) return;
-    sortSpheresBySize();
+    chooseLevels();
     rebuildGroups();
     std::vector<GpuInstance> all;
     all.reserve(staticInstances_.size() + bodyInstances_.size() + particleInstances_.size());
@@ -236,13 +251,23 @@ void SceneRenderer::bindInstances() const {
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kInstanceBinding, instanceBuffer_.id());
 }
 
+template <class Visit>
+void SceneRenderer::forEachGroupDrawn(const DrawFilter& filter, Visit visit) const {
+    for (auto& g : groups_)
+        if ((filter.categories & g.category) && (g.anyLod || g.lod == filter.lod)) visit(g);
+}
+
+uint64_t SceneRenderer::triangles(const DrawFilter& filter) const {
+    uint64_t n = 0;
+    forEachGroupDrawn(filter, [&](const Group& g) { n += uint64_t(meshes_[g.mesh].indexCount / 3) * g.count; });
+    return n;
+}
+
 void SceneRenderer::draw(const DrawFilter& filter) const {
     if (!instanceBuffer_) return;
     glBindVertexArray(vao_.id());
     bindInstances();
-    for (auto& g : groups_) {
-        if (!(filter.categories & g.category)) continue;
-        if (!g.anyLod && g.lod != filter.lod) continue;
+    forEachGroupDrawn(filter, [&](const Group& g) {
         const MeshRange& m = meshes_[g.mesh];
         // The per-instance attribute reads 0, 1, 2, … starting at `first`, so the shader
         // indexes the instance buffer with it (no gl_BaseInstance needed: GL 4.5 core).
@@ -250,7 +275,7 @@ void SceneRenderer::draw(const DrawFilter& filter) const {
             GL_TRIANGLES, static_cast<GLsizei>(m.indexCount), GL_UNSIGNED_INT,
             reinterpret_cast<const void*>(static_cast<uintptr_t>(m.firstIndex) * 4), static_cast<GLsizei>(g.count),
             static_cast<GLint>(m.baseVertex), g.first);
-    }
+    });
     glBindVertexArray(0);
 }
 

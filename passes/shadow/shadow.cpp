@@ -18,8 +18,8 @@ namespace {
 // "shadow caster_mesh" (covered texels within 0.3 %) see the same shadows.
 kiln::Lod casterLod(kiln::PassContext& ctx) {
     const std::string& mesh = ctx.getEnum("caster_mesh");
-    if (mesh == "auto") return ctx.getInt("size") <= 1024 ? kiln::Lod::Medium : kiln::Lod::High;
-    return mesh == "medium" ? kiln::Lod::Medium : mesh == "coarse" ? kiln::Lod::Low : kiln::Lod::High;
+    if (mesh == "auto") return ctx.getInt("size") <= 1024 ? kiln::Lod::Medium : kiln::Lod::Fine;
+    return mesh == "medium" ? kiln::Lod::Medium : mesh == "coarse" ? kiln::Lod::Low : kiln::Lod::Fine;
 }
 
 class Shadow final : public kiln::Pass {
@@ -33,7 +33,7 @@ public:
             .param(intChoiceParam("size", 2048, {256, 512, 1024, 2048, 4096}, "shadow map side in texels"))
             .param(floatParam("slope_bias", 2.0f, 0.0, 10.0, "polygon offset factor against shadow acne"))
             .param(enumParam("caster_mesh", "auto", {"auto", "fine", "medium", "coarse"},
-                             "the casters' meshes: fine (the camera's: tumblers at 48 slices), medium (24 slices, "
+                             "the casters' meshes: fine (the finest: tumblers at 48 slices, 32-segment spheres), medium (24 slices, "
                              "16-segment spheres), coarse (the voxelizer's: 12, 10) or auto: medium up to a 1024² map"));
         d.reads = kSceneShadowCasters | kSceneLight;
         return d;

@@ -16,8 +16,10 @@
 #include "app/texture_viewer.hpp"
 #include "kiln/image_io.hpp"
 #include "support/golden.hpp"
+#include "scene/mesh.hpp"
 #include "scene/scene_renderer.hpp"
 #include "support/headless.hpp"
+#include "kiln/sim/shape.hpp"
 
 namespace fs = std::filesystem;
 using namespace kiln;
@@ -353,6 +355,89 @@ TEST_CASE("sphere level of detail: the silhouette stays within a pixel of the ci
     CHECK(worst < 1.0);
     CHECK(worst > 0.5);  // and the coarse meshes are really used near their limits
     CHECK(scene::sphereLevelFor(500.0f) == 0);
+}
+
+TEST_CASE("tumbler level of detail: the camera's meshes stay within a pixel of the round cone where each is used",
+          "[scene]") {
+    // Checked against the simulation's exact signed distance to the round cone
+    // (sim::RoundCone::sdf), not the meshes' own construction: points across every
+    // triangle of the near and the far camera mesh of the shipped tumbler, each one's
+    // largest |distance| as a share of the bounding radius the renderer measures size on
+    // screen by, times the largest radius in pixels it is drawn at (the far mesh below
+    // kTumblerNearPx, the near one up to 500 px): under a pixel.
+    const double b = 0.2, t = 0.1, alpha = 20.0 * M_PI / 180.0;  // scenes/cornell.json
+    const sim::RoundCone cone(b, t, alpha);
+    const float bounding = scene::tumblerBoundingRadius(float(b), float(t), float(alpha));
+    auto worstShare = [&](const scene::TumblerMesh& m) {
+        const scene::MeshData mesh = scene::makeTumbler(
+            float(b), float(t), float(alpha), m.slices, m.stacks,
+            m.inflated ? scene::areaPreservingInflation(float(b), m.slices) : 0.0f);
+        double worst = 0.0;
+        for (size_t i = 0; i + 2 < mesh.indices.size(); i += 3) {
+            const glm::dvec3 p0 = mesh.vertices[mesh.indices[i]].position, p1 = mesh.vertices[mesh.indices[i + 1]].position,
+                             p2 = mesh.vertices[mesh.indices[i + 2]].position;
+            for (int u = 0; u <= 8; ++u)
+                for (int v = 0; u + v <= 8; ++v) {
+                    const glm::dvec3 p = p0 + (p1 - p0) * (u / 8.0) + (p2 - p0) * (v / 8.0);
+                    worst = std::max(worst, std::abs(cone.sdf(sim::Vec3(p.x, p.y, p.z))));
+                }
+        }
+        return worst / bounding;
+    };
+    const double nearShare = worstShare(scene::kTumblerNear), farShare = worstShare(scene::kTumblerFar);
+    INFO("near mesh: " << nearShare * 100 << " % of the bounding radius, far: " << farShare * 100 << " %");
+    CHECK(farShare * scene::kTumblerNearPx < 1.0);
+    CHECK(farShare * scene::kTumblerNearPx > 0.5);  // and the far mesh is really used near its limit
+    CHECK(nearShare * 500.0 < 1.0);
+    CHECK(scene::kTumblerNear.slices > scene::kTumblerFar.slices);
+}
+
+TEST_CASE("tumbler level of detail: the camera takes the far mesh while every tumbler is small on screen",
+          "[scene][gl]") {
+    // Three upright tumblers 3 m from the viewer (a bounding radius of 0.41 m, so
+    // kTumblerNearPx needs about 1 800 pixels a unit); one brought to 1 m. The camera's
+    // draw (Lod::High) issues the far mesh's triangles for all three until the largest
+    // on screen passes the threshold, then the near one's; Lod::Fine the near one's and
+    // Lod::Medium the shadow map's whatever the camera sees.
+    REQUIRE(test::ensureHeadlessContext());
+    scene::SceneRenderer renderer;
+    const scene::SceneLook look;
+    renderer.setLook(look);
+    auto tumblerAt = [](glm::vec3 p) {
+        scene::BodyInstance b;
+        b.model = glm::translate(glm::mat4(1.0f), p);
+        return b;
+    };
+    std::vector<scene::BodyInstance> bodies = {tumblerAt({-0.5f, 0.0f, 0.0f}), tumblerAt({0.0f, 0.0f, 0.0f}),
+                                               tumblerAt({0.5f, 0.0f, 0.0f})};
+    auto trianglesOf = [](const scene::TumblerMesh& m) {
+        return uint64_t(scene::makeTumbler(0.2f, 0.1f, 0.349066f, m.slices, m.stacks).indices.size() / 3);
+    };
+    const uint64_t nearMesh = trianglesOf(scene::kTumblerNear), farMesh = trianglesOf(scene::kTumblerFar),
+                   shadowMesh = trianglesOf(scene::kTumblerShadow);
+    REQUIRE(farMesh < nearMesh);
+    auto drawn = [&](kiln::Lod lod) { return renderer.triangles({.categories = kSceneTumblers, .lod = lod}); };
+    const glm::vec3 eye(0.0f, 0.0f, 3.0f);
+    const float bounding = scene::tumblerBoundingRadius(look.tumblerB, look.tumblerT, look.tumblerAlpha);
+    const float threshold = scene::kTumblerNearPx / bounding * 3.0f;  // pixels a unit at which one at 3 m is near
+    renderer.setBodies(bodies);
+    renderer.setViewer(eye, 0.9f * threshold);
+    renderer.upload();
+    CHECK(drawn(kiln::Lod::High) == 3 * farMesh);
+    CHECK(drawn(kiln::Lod::Fine) == 3 * nearMesh);
+    CHECK(drawn(kiln::Lod::Medium) == 3 * shadowMesh);
+    renderer.setViewer(eye, 1.1f * threshold);
+    renderer.upload();
+    CHECK(drawn(kiln::Lod::High) == 3 * nearMesh);
+    // Back to small, then one tumbler comes close: the largest decides for all.
+    renderer.setViewer(eye, 0.9f * threshold);
+    renderer.upload();
+    CHECK(drawn(kiln::Lod::High) == 3 * farMesh);
+    bodies[1] = tumblerAt({0.0f, 0.0f, 2.0f});
+    renderer.setBodies(bodies);
+    renderer.upload();
+    CHECK(drawn(kiln::Lod::High) == 3 * nearMesh);
+    CHECK(drawn(kiln::Lod::Fine) == 3 * nearMesh);
 }
 
 TEST_CASE("shadow caster_mesh: the 24-slice casters cast the 48-slice ones' shadow, the 12-slice ones a smaller one",

@@ -216,9 +216,9 @@ namespace kiln {
 // or when what the host does for a pass changes (6: the host issues the barrier
 // between passes; 7: GpuFrame::boxWalls; 8: PassContext::keepRunning; 9:
 // SizeRule::capSource and Lod::Medium; 10: ProgramBuild::portability; 11:
-// FrameInfo::redraw; 12: TextureRef::setup), so a module
-// built for other terms is refused by name, not run.
-inline constexpr uint32_t kPassAbiVersion = 12;
+// FrameInfo::redraw; 12: TextureRef::setup; 13: Lod::Fine, and Lod::High's tumblers by
+// their size on screen), so a module built for other terms is refused by name, not run.
+inline constexpr uint32_t kPassAbiVersion = 13;
 
 struct TextureRef {
     GLuint id = 0;

@@ -13,12 +13,14 @@
 
 namespace kiln {
 
-// High: as fine as the picture needs (marbles and fireballs pick one of three sphere
-// meshes per instance by their size on screen); Low: the coarse meshes, for passes that
-// see the scene at low resolution (voxelize); Medium: every body at its middle mesh
-// (tumblers 24 slices, spheres 16 segments), for a view of middling resolution that
-// is not the camera's (the shadow map).
-enum class Lod : uint8_t { High, Low, Medium };
+// High: as fine as the camera's picture needs (marbles and fireballs pick one of three
+// sphere meshes per instance by their size on screen, the tumblers one of two by the
+// largest's); Low: the coarse meshes, for passes that see the scene at low resolution
+// (voxelize); Medium: every body at its middle mesh (tumblers 24 slices, spheres 16
+// segments), for a view of middling resolution that is not the camera's (the shadow
+// map); Fine: every body at its finest mesh whatever the camera sees (a large shadow
+// map).
+enum class Lod : uint8_t { High, Low, Medium, Fine };
 
 // What drawScene() draws: the geometry bits of SceneCategory (kSceneGeometry,
 // kSceneShadowCasters, kSceneTumblers | kSceneMarbles, ...) at a level of detail.
