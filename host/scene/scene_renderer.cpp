@@ -213,10 +213,11 @@ void SceneRenderer::rebuildGroups() {
     add(kQuad, kSceneBox);
     add(kLamp, kSceneLamp);
     if (const uint32_t n = count(kSceneTumblers); n > 0) {
-        groups_.push_back({tumblersNear_ ? kTumblerHigh : kTumblerFarMesh, kSceneTumblers, Lod::High, false, cursor, n});
-        groups_.push_back({kTumblerHigh, kSceneTumblers, Lod::Fine, false, cursor, n});
-        groups_.push_back({kTumblerMid, kSceneTumblers, Lod::Medium, false, cursor, n});
-        groups_.push_back({kTumblerLow, kSceneTumblers, Lod::Low, false, cursor, n});
+        const MeshId camera = tumblersNear_ ? kTumblerNearMesh : kTumblerFarMesh;
+        groups_.push_back({camera, kSceneTumblers, Lod::High, false, cursor, n});
+        groups_.push_back({kTumblerNearMesh, kSceneTumblers, Lod::Fine, false, cursor, n});
+        groups_.push_back({kTumblerShadowMesh, kSceneTumblers, Lod::Medium, false, cursor, n});
+        groups_.push_back({kTumblerVoxelMesh, kSceneTumblers, Lod::Low, false, cursor, n});
         cursor += n;
     }
     addSpheres(kSceneMarbles, sphereLevels_[0]);

@@ -65,9 +65,9 @@ inline constexpr int kSphereSegments[3] = {32, 16, 10};
 // tests/integration/test_scene.cpp); the shadow map's, inflated to the round one's
 // cross-section (a shadow as large); voxelize's. The shipped tumblers' balls span 122 px
 // at 720², 183 at 1080p, 365 at 4K: the far mesh at the first two, half the near one's
-// triangles (0.75 ms of llvmpipe's 6.3 for the G-buffer at 720², relMSE unchanged:
-// 0.01064 against 0.01062 at 128², t = 0.5; 0.01185 against 0.01186 at 256², t = 0. The
-// shadow map's 24 × 8, uninflated, saved 1.0 ms but cost 256²'s relMSE 0.0002).
+// triangles (the G-buffer 6.5 → 5.4 ms at 720² on llvmpipe, relMSE unchanged: 0.01064
+// against 0.01062 at 128², t = 0.5; 0.01185 against 0.01186 at 256², t = 0. The shadow
+// map's 24 × 8, uninflated, saved 1.0 ms but cost 256²'s relMSE 0.0002).
 struct TumblerMesh {
     int slices, stacks;
     bool inflated;
@@ -108,7 +108,8 @@ public:
 
 private:
     enum MeshId {
-        kQuad, kLamp, kTumblerHigh, kTumblerFarMesh, kTumblerMid, kTumblerLow, kSphereHigh, kSphereMid, kSphereLow, kParticle, kMeshCount
+        kQuad, kLamp, kTumblerNearMesh, kTumblerFarMesh, kTumblerShadowMesh, kTumblerVoxelMesh,
+        kSphereHigh, kSphereMid, kSphereLow, kParticle, kMeshCount
     };
     struct MeshRange { uint32_t firstIndex = 0, indexCount = 0, baseVertex = 0; };
     struct Group { MeshId mesh; SceneCategory category; Lod lod; bool anyLod; uint32_t first, count; };

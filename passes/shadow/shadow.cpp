@@ -33,8 +33,9 @@ public:
             .param(intChoiceParam("size", 2048, {256, 512, 1024, 2048, 4096}, "shadow map side in texels"))
             .param(floatParam("slope_bias", 2.0f, 0.0, 10.0, "polygon offset factor against shadow acne"))
             .param(enumParam("caster_mesh", "auto", {"auto", "fine", "medium", "coarse"},
-                             "the casters' meshes: fine (the finest: tumblers at 48 slices, 32-segment spheres), medium (24 slices, "
-                             "16-segment spheres), coarse (the voxelizer's: 12, 10) or auto: medium up to a 1024² map"));
+                             "the casters' meshes: fine (the finest: tumblers at 48 slices, 32-segment spheres), "
+                             "medium (24 slices, 16-segment spheres), coarse (the voxelizer's: 12, 10) or auto: "
+                             "medium up to a 1024² map"));
         d.reads = kSceneShadowCasters | kSceneLight;
         return d;
     }

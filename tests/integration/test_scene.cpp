@@ -374,8 +374,9 @@ TEST_CASE("tumbler level of detail: the camera's meshes stay within a pixel of t
             m.inflated ? scene::areaPreservingInflation(float(b), m.slices) : 0.0f);
         double worst = 0.0;
         for (size_t i = 0; i + 2 < mesh.indices.size(); i += 3) {
-            const glm::dvec3 p0 = mesh.vertices[mesh.indices[i]].position, p1 = mesh.vertices[mesh.indices[i + 1]].position,
-                             p2 = mesh.vertices[mesh.indices[i + 2]].position;
+            const glm::dvec3 p0 = mesh.vertices[mesh.indices[i]].position;
+            const glm::dvec3 p1 = mesh.vertices[mesh.indices[i + 1]].position;
+            const glm::dvec3 p2 = mesh.vertices[mesh.indices[i + 2]].position;
             for (int u = 0; u <= 8; ++u)
                 for (int v = 0; u + v <= 8; ++v) {
                     const glm::dvec3 p = p0 + (p1 - p0) * (u / 8.0) + (p2 - p0) * (v / 8.0);
