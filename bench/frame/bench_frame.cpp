@@ -15,9 +15,10 @@
 // the tumblers asleep and no balls (time runs, nothing moves; settled too); and one
 // marble bouncing among the sleeping tumblers, redrawing only the part of the picture it
 // changes (kiln/pass.hpp) and, to compare, all of it; and the fireballs flying among
-// the sleeping tumblers, with composite's kept lamp light and without. Per situation: each pass's median GPU and
-// CPU ms over the frames it ran, how often it ran, and the median wall time per frame
-// (with a glFinish, what a user waits for), and the ratio to "moving".
+// the sleeping tumblers, with composite's kept lamp light and without. Per situation:
+// each pass's median GPU and CPU ms over the frames it ran, how often it ran, and the
+// median wall time per frame (with a glFinish, what a user waits for), and the ratio to
+// "moving".
 //
 // overhead: the CPU time of Runtime::renderFrame against the part inside the passes'
 // execute(): the rest is the graph's own (version checks, state resets, timer queries,

@@ -372,7 +372,8 @@ private:
                         GL_TEXTURE_FETCH_BARRIER_BIT);  // tiles.vert reads the lists as a buffer texture
         if (!countFence_) {
             if (!movedCount_) movedCount_ = kiln::gl::Buffer::create(sizeof(uint32_t), nullptr, 0, "composite.moved_tiles");
-            glCopyNamedBufferSubData(tileLists_.id(), movedCount_.id(), 8 * sizeof(uint32_t), 0, sizeof(uint32_t));
+            glCopyNamedBufferSubData(tileLists_.id(), movedCount_.id(), kMovedCountAt * sizeof(uint32_t), 0,
+                                     sizeof(uint32_t));
             countFence_ = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
             countedTiles_ = tileCount;
         }
@@ -454,7 +455,8 @@ private:
     kiln::gl::SamplerHandle compareSampler_;
 
     // keep_direct (the pass's own objects: a reload starts over).
-    static constexpr uint32_t kListsStart = 12;  // tile_lists.comp: two draw commands and a count first
+    // tile_lists.comp's buffer: two draw commands, the count of moved tiles at [8], the lists.
+    static constexpr uint32_t kMovedCountAt = 8, kListsStart = 12;
     // The share of moved tiles above which the whole is drawn (llvmpipe at 720²: in tiles
     // 11.7 ms + 10.4 × the share, whole 20), and below which tiles come back.
     static constexpr double kTilesUpTo = 0.75, kTilesBackBelow = 0.6;
