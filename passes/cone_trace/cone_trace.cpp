@@ -34,7 +34,10 @@
 // `samples`, with the traced surface's plane in `planes`, then a depth/normal-aware
 // upsample writes `indirect`. output_divisor 2: `indirect` is half the picture's size
 // and composite's bilinear lookup does the last step (the upsample is a full-screen
-// pass: at 720² it cost as much as the stride-4 trace). Indirect light is smooth on
+// pass: at 720² it cost as much as the stride-4 trace). output_samples N caps the
+// output's texels across as trace_samples caps the samples: the upsample costs its
+// pixels, and where a sample stands for 12 × 12 of them a half-size output mostly
+// interpolates between the same four. Indirect light is smooth on
 // surfaces, so the error stays small where a traced sample lies on the pixel's own
 // surface (measured against full resolution in tests/gi and against the path-traced
 // reference by kiln-bench-quality); at silhouettes the nearest sample stands in.
@@ -152,10 +155,10 @@ public:
                     .doc = "voxelize.lamp_transmittance (fire_cover on): alpha = the fraction of the lamp each "
                            "traced surface sees past the fire, upsampled for composite's lamp_through_fire "
                            "(shaders/common/fire.glsl)"})
-            .output({.name = "indirect", .format = Format::RGBA16F, .size = SizeRule::relativeOverParam("output_divisor"),
+            .output({.name = "indirect", .format = Format::RGBA16F, .size = SizeRule::relativeOverParam("output_divisor", 1.0f, "output_samples"),
                      .doc = "rgb = indirect irradiance / π, a = AO (or with `lamp`: the lamp's projected solid "
                             "angle; with `lamp_transmittance` bound: the fraction of the lamp seen past the fire); "
-                            "the output's size ÷ output_divisor"})
+                            "the output's size ÷ output_divisor (more where output_samples caps it)"})
             .internal({.name = "samples", .format = Format::RGBA16F, .size = traceGrid,
                        .doc = "trace_stride > 1: the traced samples"})
             .internal({.name = "planes", .format = Format::RGBA16F, .size = traceGrid,
@@ -185,8 +188,13 @@ public:
                             "at most this many traced samples across the picture's longer side: the stride grows "
                             "with the picture beyond trace_stride (0: no cap). Indirect light varies over the scene, "
                             "not over pixels: a large picture needs no more samples of it than a small one"))
-            .param(intChoiceParam("output_divisor", 1, {1, 2},
-                                  "2: upsample to half resolution; composite's bilinear lookup does the last 2×"))
+            .param(intChoiceParam("output_divisor", 1, {1, 2, 4},
+                                  "2 (4): upsample to half (a quarter of the) resolution; composite's bilinear lookup "
+                                  "does the last step"))
+            .param(intParam("output_samples", 0, 0, 4096,
+                            "at most this many texels of `indirect` across the picture's longer side: the divisor "
+                            "grows with the picture beyond output_divisor (0: no cap), as trace_samples does the "
+                            "stride's. The upsample's cost is its pixels; its edges are the traced samples'"))
             .param(floatParam("upsample_tolerance", 0.02f, 0.001, 1.0, "plane distance (world) that halves a sample's weight"))
             .param(intParam("reuse_frames", 1, 1, 8,
                             "trace_stride > output_divisor: a sample on the surface last frame's nearest sample had "
@@ -224,7 +232,8 @@ public:
         // An `indirect` pixel covers `divisor` G-buffer texels per side. A trace no
         // sparser than that goes straight into it (one texel per pixel); a sparser one
         // goes into `samples` and is upsampled.
-        const int divisor = ctx.getInt("output_divisor");
+        const int divisor = kiln::sizeDivisor(ctx.getInt("output_divisor"), ctx.getInt("output_samples"), normal.width,
+                                              normal.height);
         const bool upsampled = stride > divisor;
         const int traceStep = upsampled ? stride : divisor;
         const int reuseFrames = upsampled ? ctx.getInt("reuse_frames") : 1;
