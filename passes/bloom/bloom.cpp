@@ -1,8 +1,8 @@
 // bloom — the bright part of the picture, blurred: a bright-pass of the
 // G-buffer's emitted radiance (`color`, bound to gbuffer.emissive), then a separable
 // Gaussian of σ = radius/2 full-resolution pixels (radius 4 = the course design's 9×9 kernel).
-// It runs at HALF resolution: a compute bright-pass averages each 2×2 block into the
-// internal `bright` (the same light, a quarter of the pixels), and the blur uses
+// It runs at HALF resolution: a compute bright-pass keeps the part above the threshold
+// of each 2×2 block's mean in the internal `bright` (a quarter of the pixels), and the blur uses
 // radius/2 taps per side with σ halved, so the glow has the course design's footprint on
 // screen; composite's bilinear lookup upsamples it. Horizontal into the internal
 // `ping`, vertical into `bloom`. Composite adds it.
@@ -35,7 +35,7 @@ public:
             .output({.name = "bloom", .format = Format::RGBA16F, .size = SizeRule::relative(0.5f),
                      .doc = "blurred bright part (half resolution), added by composite"})
             .internal({.name = "bright", .format = Format::RGBA16F, .size = SizeRule::relative(0.5f),
-                       .doc = "bright-pass, 2×2 mean"})
+                       .doc = "bright-pass: the part of each 2×2 block's mean above the threshold"})
             .internal({.name = "ping", .format = Format::RGBA16F, .size = SizeRule::relative(0.5f),
                        .doc = "horizontal blur"})
             .param(floatParam("threshold", 1.0f, 0.0, 64.0, "luminance below which nothing blooms"))
