@@ -67,13 +67,17 @@ inline constexpr int kSphereSegments[3] = {32, 16, 10};
 // at 720², 183 at 1080p, 365 at 4K: the far mesh at the first two, half the near one's
 // triangles (the G-buffer 6.5 → 5.4 ms at 720² on llvmpipe, relMSE unchanged: 0.01064
 // against 0.01062 at 128², t = 0.5; 0.01185 against 0.01186 at 256², t = 0. The shadow
-// map's 24 × 8, uninflated, saved 1.0 ms but cost 256²'s relMSE 0.0002).
+// map's 24 × 8, uninflated, saved 1.0 ms but cost 256²'s relMSE 0.0002). Voxelize's
+// 8 × 3 lies inside the round cone by under the half voxel (at 32³) that conservative
+// rasterization grows it by (tests/integration/test_scene.cpp): every triangle costs
+// llvmpipe's geometry shader and a few 4 × 4 blocks of lit fragments, and 12 × 4 took
+// voxelize 0.8 ms more at 720² for relMSE 0.01156 against 0.01159 at 256², t = 0.
 struct TumblerMesh {
     int slices, stacks;
     bool inflated;
 };
 inline constexpr TumblerMesh kTumblerNear{48, 16, false}, kTumblerFar{32, 12, false}, kTumblerShadow{24, 8, true},
-    kTumblerVoxels{12, 4, false};
+    kTumblerVoxels{8, 3, false};
 constexpr float kTumblerNearPx = 250.0f;
 // The ball about the tumbler's origin (its lower ball's centre) that holds its mesh.
 inline float tumblerBoundingRadius(float b, float t, float alpha) {

@@ -427,6 +427,42 @@ TEST_CASE("tumbler level of detail: the camera's meshes stay within a pixel of t
     CHECK(scene::kTumblerNear.slices > scene::kTumblerFar.slices);
 }
 
+TEST_CASE("voxelize's tumbler mesh lies inside the round cone, by less than the half voxel conservative rasterization adds",
+          "[scene]") {
+    // voxelize.geom pushes every edge of a triangle out by half a voxel (more along a
+    // diagonal) in its projection, so the voxels a mesh marks reach half a voxel past
+    // it. An inscribed mesh that strays inside the round cone by less than that still
+    // marks the voxels the shape's surface passes through. Checked against the
+    // simulation's exact signed distance: points across every triangle, none outside
+    // the shape (beyond rounding), the deepest inside under half a voxel of the default
+    // 32^3 over the box's 2 m (measured 0.39 for 8 x 3; 0.20 for the 12 x 4 mesh it
+    // replaced, 0.73 for 6 x 2), and over a quarter: the mesh is about as coarse as that
+    // allows, for its triangles are what voxelize pays for.
+    const double b = 0.2, t = 0.1, alpha = 20.0 * M_PI / 180.0;  // scenes/cornell.json
+    const sim::RoundCone cone(b, t, alpha);
+    const scene::TumblerMesh m = scene::kTumblerVoxels;
+    REQUIRE_FALSE(m.inflated);
+    const scene::MeshData mesh = scene::makeTumbler(float(b), float(t), float(alpha), m.slices, m.stacks);
+    double outside = 0.0, inside = 0.0;
+    for (size_t i = 0; i + 2 < mesh.indices.size(); i += 3) {
+        const glm::dvec3 p0 = mesh.vertices[mesh.indices[i]].position;
+        const glm::dvec3 p1 = mesh.vertices[mesh.indices[i + 1]].position;
+        const glm::dvec3 p2 = mesh.vertices[mesh.indices[i + 2]].position;
+        for (int u = 0; u <= 8; ++u)
+            for (int v = 0; u + v <= 8; ++v) {
+                const glm::dvec3 p = p0 + (p1 - p0) * (u / 8.0) + (p2 - p0) * (v / 8.0);
+                const double d = cone.sdf(sim::Vec3(p.x, p.y, p.z));
+                outside = std::max(outside, d);
+                inside = std::max(inside, -d);
+            }
+    }
+    const double voxel = 2.0 / 32.0;
+    INFO("deepest inside " << inside / voxel << " voxel, furthest outside " << outside / voxel << " voxel at 32^3");
+    CHECK(outside < 1e-5);
+    CHECK(inside < 0.5 * voxel);
+    CHECK(inside > 0.25 * voxel);
+}
+
 TEST_CASE("tumbler level of detail: the camera takes the far mesh while every tumbler is small on screen",
           "[scene][gl]") {
     // Three upright tumblers 3 m from the viewer (a bounding radius of 0.41 m, so
