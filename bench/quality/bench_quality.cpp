@@ -86,10 +86,10 @@ const char* const kDefaultSweeps[] = {
     "voxelize.resolution=32,64,128",
     "cone_trace.aperture=30,45,60,90", "cone_trace.schedule=octave,continuous", "cone_trace.trace_stride=1,2,4",
     "composite.pcf=1,3,5,9",          "shadow.size=512,1024,2048,4096",
-    "cone_trace.output_divisor=1,2",  "composite.lamp_samples=8,16,32",
+    "cone_trace.output_divisor=1,2",  "cone_trace.output_samples=0,240,192", "composite.lamp_samples=8,16,32",
     "voxel_mip.feedback=false,true",  "voxel_mip.gather_diameter_offset=1,1.25,1.5",
     "composite.lamp_model=field,contour,points",
-    "shadow.caster_mesh=fine,medium,coarse", "voxelize.tumbler_mode=mesh,splat",
+    "shadow.caster_mesh=fine,medium,coarse", "voxelize.tumbler_mode=mesh,splat", "voxelize.lamp_model=field,points",
 };
 
 struct Args {

@@ -155,7 +155,8 @@ public:
                     .doc = "voxelize.lamp_transmittance (fire_cover on): alpha = the fraction of the lamp each "
                            "traced surface sees past the fire, upsampled for composite's lamp_through_fire "
                            "(shaders/common/fire.glsl)"})
-            .output({.name = "indirect", .format = Format::RGBA16F, .size = SizeRule::relativeOverParam("output_divisor", 1.0f, "output_samples"),
+            .output({.name = "indirect", .format = Format::RGBA16F,
+                     .size = SizeRule::relativeOverParam("output_divisor", 1.0f, "output_samples"),
                      .doc = "rgb = indirect irradiance / π, a = AO (or with `lamp`: the lamp's projected solid "
                             "angle; with `lamp_transmittance` bound: the fraction of the lamp seen past the fire); "
                             "the output's size ÷ output_divisor (more where output_samples caps it)"})

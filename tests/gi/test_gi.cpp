@@ -1285,7 +1285,8 @@ TEST_CASE("default pipeline: no NaN or Inf in any texture (every level of the vo
     CHECK(scanned > 10);
 }
 
-TEST_CASE("cone_trace trace_stride and trace_samples: the depth/normal-aware upsample stays close to tracing every pixel",
+TEST_CASE("cone_trace trace_stride, trace_samples and output_samples: the depth/normal-aware upsample stays close to "
+          "tracing every pixel",
           "[gi][cone]") {
     // Same frame traced at every pixel, at strides 2 and 4, and at stride 4 upsampled
     // to a half-size output (output_divisor 2, read bilinearly at each pixel centre as

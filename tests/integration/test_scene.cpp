@@ -391,6 +391,21 @@ TEST_CASE("sphere level of detail: the silhouette stays within a pixel of the ci
     CHECK(scene::sphereLevelFor(500.0f) == 0);
 }
 
+namespace {
+// Points across every triangle of a mesh: a barycentric grid of 8 steps an edge (45 a
+// triangle, its corners and edges included), each passed to `visit`.
+template <class Visit>
+void forPointsAcrossTriangles(const scene::MeshData& mesh, Visit&& visit) {
+    for (size_t i = 0; i + 2 < mesh.indices.size(); i += 3) {
+        const glm::dvec3 p0 = mesh.vertices[mesh.indices[i]].position;
+        const glm::dvec3 p1 = mesh.vertices[mesh.indices[i + 1]].position;
+        const glm::dvec3 p2 = mesh.vertices[mesh.indices[i + 2]].position;
+        for (int u = 0; u <= 8; ++u)
+            for (int v = 0; u + v <= 8; ++v) visit(p0 + (p1 - p0) * (u / 8.0) + (p2 - p0) * (v / 8.0));
+    }
+}
+}  // namespace
+
 TEST_CASE("tumbler level of detail: the camera's meshes stay within a pixel of the round cone where each is used",
           "[scene]") {
     // Checked against the simulation's exact signed distance to the round cone
@@ -407,16 +422,9 @@ TEST_CASE("tumbler level of detail: the camera's meshes stay within a pixel of t
             float(b), float(t), float(alpha), m.slices, m.stacks,
             m.inflated ? scene::areaPreservingInflation(float(b), m.slices) : 0.0f);
         double worst = 0.0;
-        for (size_t i = 0; i + 2 < mesh.indices.size(); i += 3) {
-            const glm::dvec3 p0 = mesh.vertices[mesh.indices[i]].position;
-            const glm::dvec3 p1 = mesh.vertices[mesh.indices[i + 1]].position;
-            const glm::dvec3 p2 = mesh.vertices[mesh.indices[i + 2]].position;
-            for (int u = 0; u <= 8; ++u)
-                for (int v = 0; u + v <= 8; ++v) {
-                    const glm::dvec3 p = p0 + (p1 - p0) * (u / 8.0) + (p2 - p0) * (v / 8.0);
-                    worst = std::max(worst, std::abs(cone.sdf(sim::Vec3(p.x, p.y, p.z))));
-                }
-        }
+        forPointsAcrossTriangles(mesh, [&](const glm::dvec3& p) {
+            worst = std::max(worst, std::abs(cone.sdf(sim::Vec3(p.x, p.y, p.z))));
+        });
         return worst / bounding;
     };
     const double nearShare = worstShare(scene::kTumblerNear), farShare = worstShare(scene::kTumblerFar);
@@ -444,18 +452,11 @@ TEST_CASE("voxelize's tumbler mesh lies inside the round cone, by less than the 
     REQUIRE_FALSE(m.inflated);
     const scene::MeshData mesh = scene::makeTumbler(float(b), float(t), float(alpha), m.slices, m.stacks);
     double outside = 0.0, inside = 0.0;
-    for (size_t i = 0; i + 2 < mesh.indices.size(); i += 3) {
-        const glm::dvec3 p0 = mesh.vertices[mesh.indices[i]].position;
-        const glm::dvec3 p1 = mesh.vertices[mesh.indices[i + 1]].position;
-        const glm::dvec3 p2 = mesh.vertices[mesh.indices[i + 2]].position;
-        for (int u = 0; u <= 8; ++u)
-            for (int v = 0; u + v <= 8; ++v) {
-                const glm::dvec3 p = p0 + (p1 - p0) * (u / 8.0) + (p2 - p0) * (v / 8.0);
-                const double d = cone.sdf(sim::Vec3(p.x, p.y, p.z));
-                outside = std::max(outside, d);
-                inside = std::max(inside, -d);
-            }
-    }
+    forPointsAcrossTriangles(mesh, [&](const glm::dvec3& p) {
+        const double d = cone.sdf(sim::Vec3(p.x, p.y, p.z));
+        outside = std::max(outside, d);
+        inside = std::max(inside, -d);
+    });
     const double voxel = 2.0 / 32.0;
     INFO("deepest inside " << inside / voxel << " voxel, furthest outside " << outside / voxel << " voxel at 32^3");
     CHECK(outside < 1e-5);
