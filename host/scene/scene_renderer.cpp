@@ -156,6 +156,10 @@ void SceneRenderer::setViewer(glm::vec3 eye, float pixelsPerUnit) {
 // At a third of the triangles for the usual 20–40-px marble (measured: 100 marbles at
 // 720² cost 1.21× the 3-marble frame with one 24-segment mesh, 1.08× with these).
 void SceneRenderer::chooseLevels() {
+    // The pixels across the screen of a length `radius` at instance g's origin.
+    auto onScreenPx = [&](const GpuInstance& g, float radius) {
+        return radius / std::max(glm::length(glm::vec3(g.model[3]) - eye_), 1e-3f) * pixelsPerUnit_;
+    };
     size_t first = 0;
     int k = 0;
     for (SceneCategory c : {kSceneTumblers, kSceneMarbles, kSceneFireballs}) {
@@ -165,16 +169,12 @@ void SceneRenderer::chooseLevels() {
             float largestPx = 0.0f;
             for (size_t i = first; i < first + n; ++i) {
                 const GpuInstance& g = bodyInstances_[i];
-                const float scale = glm::length(glm::vec3(g.model[1]));
-                const float distance = std::max(glm::length(glm::vec3(g.model[3]) - eye_), 1e-3f);
-                largestPx = std::max(largestPx, tumblerRadius_ * scale / distance * pixelsPerUnit_);
+                largestPx = std::max(largestPx, onScreenPx(g, tumblerRadius_ * glm::length(glm::vec3(g.model[1]))));
             }
             tumblersNear_ = largestPx >= kTumblerNearPx;
         } else {
             auto level = [&](const GpuInstance& g) {
-                const float radius = glm::length(glm::vec3(g.model[0]));
-                const float distance = std::max(glm::length(glm::vec3(g.model[3]) - eye_), 1e-3f);
-                return sphereLevelFor(radius / distance * pixelsPerUnit_);
+                return sphereLevelFor(onScreenPx(g, glm::length(glm::vec3(g.model[0]))));
             };
             auto begin = bodyInstances_.begin() + std::ptrdiff_t(first), end = begin + std::ptrdiff_t(n);
             auto mid = std::stable_partition(begin, end, [&](const GpuInstance& g) { return level(g) == 0; });

@@ -9,9 +9,9 @@ namespace {
 // The map resolves the casters no better than its texels: over its 140° a 512² map has
 // 93 texels per metre at a metre from the lamp, so a tumbler (lower radius 0.2) 1.5 m
 // below it spans a radius of 12 texels, where its mesh strays from the round cone by
-// r·(1 − cos(π/n)): 0.03 of a texel at 48 slices, 0.1 at 24, 0.4 at 12 (the
-// voxelizer's, an inscribed 12-gon 4.5 % short in area: the floor 0.5 % too bright at
-// 128², t = 0.5); at 1024² twice that. The medium tumbler is a 24-gon moved out to its
+// r·(1 − cos(π/n)): 0.03 of a texel at 48 slices, 0.1 at 24, 0.4 at 12, 0.9 at 8 (the
+// voxelizer's; an inscribed 12-gon, 4.5 % short in area, already left the floor 0.5 %
+// too bright at 128², t = 0.5); at 1024² twice that. The medium tumbler is a 24-gon moved out to its
 // circle's area (host/scene/mesh.hpp). llvmpipe sets up every triangle on the CPU: at
 // 720² the map took 3.0 ms with the 48-slice tumblers, 1.3 with the medium ones; the
 // quality bench (relMSE 0.01248 -> 0.01251 at 128², t = 0.5) and test_scene's
@@ -34,7 +34,7 @@ public:
             .param(floatParam("slope_bias", 2.0f, 0.0, 10.0, "polygon offset factor against shadow acne"))
             .param(enumParam("caster_mesh", "auto", {"auto", "fine", "medium", "coarse"},
                              "the casters' meshes: fine (the finest: tumblers at 48 slices, 32-segment spheres), "
-                             "medium (24 slices, 16-segment spheres), coarse (the voxelizer's: 12, 10) or auto: "
+                             "medium (24 slices, 16-segment spheres), coarse (the voxelizer's: 8, 10) or auto: "
                              "medium up to a 1024² map"));
         d.reads = kSceneShadowCasters | kSceneLight;
         return d;

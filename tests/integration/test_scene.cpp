@@ -512,17 +512,17 @@ TEST_CASE("tumbler level of detail: the camera takes the far mesh while every tu
     CHECK(drawn(kiln::Lod::Fine) == 3 * nearMesh);
 }
 
-TEST_CASE("shadow caster_mesh: the 24-slice casters cast the 48-slice ones' shadow, the 12-slice ones a smaller one",
+TEST_CASE("shadow caster_mesh: the 24-slice casters cast the 48-slice ones' shadow, the voxelizer's a smaller one",
           "[scene][gl]") {
     // Five tumblers, upright and tilted, nothing else (a marble's mesh in the camera's
     // list depends on its size on screen), into the default's 512² map with each caster
     // mesh. What decides a shadow is where a caster is (depth < 1): the covered texels.
     // auto = medium at 512²: its tumblers are 24-gons moved out to their circle's area
-    // (an inscribed 48-gon has 0.3 % less, an inscribed 12-gon 4.5 %). Measured: covered
-    // texels medium / fine 1.003 (the 48-gon's own shortfall), coarse / fine 0.962;
-    // texels covered by one and not the other 0.5 % of the fine map's, 3.8 % for coarse. Bounds: 1 % in area, 2 %
-    // differing texels — a 12-slice caster fails both, as it lightened the floor by 0.5 %
-    // at 128², t = 0.5.
+    // (an inscribed 48-gon has 0.3 % less, an inscribed 8-gon, the voxelizer's, 10 %).
+    // Measured: covered texels medium / fine 1.003 (the 48-gon's own shortfall), coarse /
+    // fine 0.909; texels covered by one and not the other 0.5 % of the fine map's, 9.1 %
+    // for coarse. Bounds: 1 % in area, 2 % differing texels — a 12-slice caster (0.962,
+    // 3.8 %) already failed both, as it lightened the floor by 0.5 % at 128², t = 0.5.
     const fs::path scene = fs::path(TEST_OUTPUT_DIR) / "five_tumblers.json";
     std::ofstream(scene) << R"({"tumblers": [
         {"position": [-0.5, -0.4], "tilt": [0.0, 0.0]}, {"position": [0.5, -0.4], "tilt": [0.3, 0.0]},
