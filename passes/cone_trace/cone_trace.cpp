@@ -45,7 +45,7 @@
 // frame's nearest sample was traced, with its normal, keeps that sample's light (and
 // lamp) for up to N − 1 frames; tiles of 8×8 samples retrace in turn. The internal
 // `ages` holds each sample's age and traced point; `history*` are last frame's
-// samples, planes and ages (shaders/cone_trace/cone_trace.frag; README "Reusing traced
+// samples, planes and ages (shaders/cone_trace/cone_trace.comp; README "Reusing traced
 // light" for its cost and its error on moving sequences).
 #include <kiln/hash.hpp>
 #include <kiln/pass.hpp>
@@ -240,13 +240,11 @@ public:
         const int reuseFrames = upsampled ? ctx.getInt("reuse_frames") : 1;
         const bool reuse = reuseFrames > 1;
         defines.emplace_back("KILN_REUSE", reuse ? "1" : "0");
-        GLuint trace = ctx.program({.stages = {"common/fullscreen.vert", "cone_trace/cone_trace.frag"}, .defines = defines});
+        defines.emplace_back("KILN_STRIDED", upsampled ? "1" : "0");
+        GLuint trace = ctx.program({.stages = {"cone_trace/cone_trace.comp"}, .defines = defines});
         GLuint upsample = ctx.program({.stages = {"common/fullscreen.vert", "cone_trace/upsample.frag"}});
         if (!trace || !upsample) return;
 
-        if (!(reuse ? ctx.framebuffer({"samples", "planes", "ages"})
-                    : upsampled ? ctx.framebuffer({"samples", "planes"}) : ctx.framebuffer({"indirect"})))
-            return;
         glUseProgram(trace);
         if (reuse) bindHistory(ctx, trace, reuseFrames);
         kiln::gl::bindTexture(trace, "u_normal", ctx.input("normal").id);
@@ -265,12 +263,23 @@ public:
         glUniform1f(loc("u_diameterOffset"), ctx.getFloat("diameter_offset"));
         glUniform1f(loc("u_voxelRes"), float(voxels.width));
         glUniform1i(loc("u_stride"), traceStep);
+        const kiln::TextureRef& target = upsampled ? ctx.internal("samples") : ctx.output("indirect");
+        kiln::gl::bindImage(trace, "u_traced", target.id, 0, false, GL_WRITE_ONLY, GL_RGBA16F);
+        kiln::gl::bindImage(trace, "u_planes", ctx.internal("planes").id, 0, false, GL_WRITE_ONLY, GL_RGBA16F);
+        kiln::gl::bindImage(trace, "u_ages", ctx.internal("ages").id, 0, false, GL_WRITE_ONLY, GL_RGBA32F);
         // Where only bodies moved, only what they change (kiln/pass.hpp), grown by the
         // two traced texels each side the upsampling reads; the reuse variant keeps its
-        // own history of every tile and redraws all.
-        const kiln::TextureRef& target = upsampled ? ctx.internal("samples") : ctx.output("indirect");
-        if (reuse) ctx.drawFullscreenTriangle();
-        else kiln::forEachRedrawRect(ctx, target.width, target.height, 2, [&] { ctx.drawFullscreenTriangle(); });
+        // own history of every tile and traces all.
+        const std::vector<kiln::PixelRect> rects =
+            reuse ? std::vector<kiln::PixelRect>{{0, 0, target.width, target.height}}
+                  : kiln::redrawRects(ctx, target.width, target.height, 2);
+        for (const kiln::PixelRect& r : rects) {
+            glUniform4i(loc("u_rect"), r.x, r.y, r.width, r.height);
+            glDispatchCompute(GLuint((r.width + 7) / 8), GLuint((r.height + 7) / 8), 1);
+        }
+        // The upsample (or with stride 1 the passes after this one) fetch what it wrote;
+        // the reuse variant copies it.
+        glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
         if (reuse) keepHistory(ctx);
 
         if (upsampled) {

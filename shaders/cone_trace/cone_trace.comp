@@ -1,9 +1,13 @@
 #version 450 core
 // Per-pixel diffuse cone tracing: every pixel (stride 1), or one pixel per stride×stride
-// block: then pixel ij traces the G-buffer texel stride·ij + stride/2 (traceTexel in
+// block: then sample ij traces the G-buffer texel stride·ij + stride/2 (traceTexel in
 // upsample.glsl) and also writes that surface's plane for upsample.frag. Alpha: the
 // cone-traced ambient visibility, or (cone_trace.lamp) the lamp's projected solid angle,
 // or (`lamp_transmittance` bound) the fraction of the lamp seen past the fire.
+// A compute shader, one invocation a sample, over the rectangle u_rect: llvmpipe shades
+// a framebuffer in tiles of 64 × 64 pixels, one thread a tile, so a strided trace
+// drawn as fragments (64 × 64 samples at 720²) ran on one of the machine's threads,
+// where its workgroups spread over all of them.
 #include "common/frame.glsl"
 #include "trace.glsl"
 #if KILN_LAMP_IN_ALPHA
@@ -15,12 +19,19 @@ layout(binding = 10) uniform sampler3D u_lampTransmittance;
 #endif
 #include "upsample.glsl"
 
+layout(local_size_x = 8, local_size_y = 8) in;
+
 layout(binding = 0) uniform sampler2D u_normal;
 layout(binding = 1) uniform sampler2D u_depth;
 uniform int u_stride;
+uniform ivec4 u_rect;  // the samples to trace: x, y, width, height
 
-layout(location = 0) out vec4 o_indirect;
-layout(location = 1) out vec4 o_plane;  // xyz = unit normal, w = n·p; 0 off geometry
+// `samples` (strided) or `indirect` (stride 1), and KILN_STRIDED each sample's surface,
+// xyz = unit normal, w = n·p; 0 off geometry.
+layout(rgba16f, binding = 0) uniform writeonly image2D u_traced;
+#if KILN_STRIDED
+layout(rgba16f, binding = 1) uniform writeonly image2D u_planes;
+#endif
 
 #if KILN_REUSE
 // Temporal reuse (cone_trace.reuse_frames > 1, strided traces only). A sample within
@@ -38,7 +49,8 @@ uniform mat4 u_prevViewProj;
 uniform int u_reuseFrames;
 uniform int u_frame;             // which tiles retrace this frame
 uniform float u_reuseTolerance;  // world units
-layout(location = 2) out vec4 o_age;  // x: frames this sample's light has been kept; yzw: the point traced
+// x: frames this sample's light has been kept; yzw: the point traced.
+layout(rgba32f, binding = 2) uniform writeonly image2D u_ages;
 
 // Last frame's sample nearest the point p (h, and its age and traced point in kept),
 // and whether its surface is p's.
@@ -55,14 +67,22 @@ bool reusable(vec3 p, vec3 n, out ivec2 h, out vec4 kept) {
 }
 #endif
 
+void store(ivec2 ij, vec4 indirect, vec4 plane) {
+    imageStore(u_traced, ij, indirect);
+#if KILN_STRIDED
+    imageStore(u_planes, ij, plane);
+#endif
+}
+
 void main() {
-    ivec2 src = traceTexel(ivec2(gl_FragCoord.xy), u_stride);
+    if (any(greaterThanEqual(ivec2(gl_GlobalInvocationID.xy), u_rect.zw))) return;
+    ivec2 ij = u_rect.xy + ivec2(gl_GlobalInvocationID.xy);
+    ivec2 src = traceTexel(ij, u_stride);
     vec4 n4 = texelFetch(u_normal, src, 0);
     if (n4.w < 0.5) {
-        o_indirect = vec4(0.0, 0.0, 0.0, 1.0);
-        o_plane = vec4(0.0);
+        store(ij, vec4(0.0, 0.0, 0.0, 1.0), vec4(0.0));
 #if KILN_REUSE
-        o_age = vec4(0.0, vec3(1e4));  // off geometry: nowhere
+        imageStore(u_ages, ij, vec4(0.0, vec3(1e4)));  // off geometry: nowhere
 #endif
         return;
     }
@@ -73,26 +93,30 @@ void main() {
     vec4 kept;
     bool same = reusable(p, n, h, kept);
     float age = kept.x;
-    ivec2 tile = ivec2(gl_FragCoord.xy) / 8;
+    ivec2 tile = ij / 8;
     bool due = (tile.x + 3 * tile.y + u_frame) % u_reuseFrames == 0;
     bool trace = due || !same || age >= float(u_reuseFrames - 1);
-    o_indirect = texelFetch(u_history, h, 0);
-    o_age = vec4(age + 1.0, kept.yzw);
+    vec4 indirect = texelFetch(u_history, h, 0);
+    vec4 age4 = vec4(age + 1.0, kept.yzw);
     for (int k = trace ? 0 : 1; k < 1; ++k) {
 #else
+    vec4 indirect;
     {  // every sample traced (a loop around it, even a constant one, cost 2 ms at 720²)
 #endif
-        o_indirect = traceDiffuse(p, n);
+        indirect = traceDiffuse(p, n);
 #if KILN_LAMP_IN_ALPHA
         // The lamp's unshadowed irradiance ÷ its radiance (smooth on a surface, like the
         // indirect light): traced here at one pixel in stride², upsampled with it.
-        o_indirect.a = lampProjectedSolidAngle(p, n);
+        indirect.a = lampProjectedSolidAngle(p, n);
 #elif KILN_HAS_LAMP_TRANSMITTANCE
-        o_indirect.a = textureLod(u_lampTransmittance, p * 0.5 + 0.5, 0.0).r;  // upsampled for composite
+        indirect.a = textureLod(u_lampTransmittance, p * 0.5 + 0.5, 0.0).r;  // upsampled for composite
 #endif
 #if KILN_REUSE
-        o_age = vec4(0.0, p);
+        age4 = vec4(0.0, p);
 #endif
     }
-    o_plane = vec4(n, dot(n, p));
+    store(ij, indirect, vec4(n, dot(n, p)));
+#if KILN_REUSE
+    imageStore(u_ages, ij, age4);
+#endif
 }
