@@ -284,20 +284,24 @@ private:
     // The raster state for adding meshes to sums `target`: the program in use with its
     // inputs bound, an attachment-less framebuffer of the voxels' size.
     void beginRaster(kiln::PassContext& ctx, GLuint raster, int res, GLuint target) {
+        // One viewport an axis (voxelize.geom), whole llvmpipe tiles apart, so that its
+        // threads share the fragments (on one 32² viewport one thread shaded them all).
+        const int axisStep = (res + kRasterTile - 1) / kRasterTile * kRasterTile;
         if (!fbo_) fbo_ = kiln::gl::createFramebuffer();
         if (fboSize_ != res) {
-            glNamedFramebufferParameteri(fbo_.id(), GL_FRAMEBUFFER_DEFAULT_WIDTH, res);
+            glNamedFramebufferParameteri(fbo_.id(), GL_FRAMEBUFFER_DEFAULT_WIDTH, 3 * axisStep);
             glNamedFramebufferParameteri(fbo_.id(), GL_FRAMEBUFFER_DEFAULT_HEIGHT, res);
             fboSize_ = res;
         }
         glBindFramebuffer(GL_FRAMEBUFFER, fbo_.id());
-        glViewport(0, 0, res, res);
+        for (GLuint axis = 0; axis < 3; ++axis) glViewportIndexedf(axis, float(axis) * axisStep, 0.0f, float(res), float(res));
         glDisable(GL_DEPTH_TEST);
         glDisable(GL_CULL_FACE);
         glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
         useSurfaceProgram(ctx, raster, res);
         kiln::gl::bindImage(raster, "u_sums", target, 0, true, GL_READ_WRITE, GL_R32UI);
         glUniform1f(glGetUniformLocation(raster, "u_conservative"), ctx.getBool("conservative") ? 1.0f : 0.0f);
+        glUniform1i(glGetUniformLocation(raster, "u_axisViewportStep"), axisStep);
     }
 
     // The lamp dome into the sums `raster` is set up for (beginRaster): at lamp_emission,
@@ -494,6 +498,7 @@ private:
 
     kiln::gl::FramebufferHandle fbo_;  // attachment-less; a GL cache only (a reload makes a new one)
     int fboSize_ = 0;
+    static constexpr int kRasterTile = 64;  // llvmpipe shades a framebuffer in tiles of 64², one thread each
 };
 
 }  // namespace

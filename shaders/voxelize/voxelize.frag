@@ -26,6 +26,7 @@ flat in vec2 v_depthRange;
 ivec3 voxelAt(int k, ivec2 ij, int axis) { return axis == 0 ? ivec3(k, ij.x, ij.y) : axis == 1 ? ivec3(ij.y, k, ij.x) : ivec3(ij, k); }
 
 uniform float u_emissionScale;  // 1, or lamp_emission while drawing the lamp
+uniform int u_axisViewportStep;  // the axes' viewports lie this many pixels apart in x (voxelize.geom)
 uniform bool u_sphereFlux;      // the fireballs: scale each to its sphere's flux (below)
 
 void main() {
@@ -37,7 +38,7 @@ void main() {
     float depth = v_axis == 0 ? v_world.x : v_axis == 1 ? v_world.y : v_world.z;
     float span = 0.5 * (abs(dFdx(depth)) + abs(dFdy(depth)));
 
-    vec2 px = gl_FragCoord.xy;
+    vec2 px = gl_FragCoord.xy - vec2(float(v_axis * u_axisViewportStep), 0.0);
     if (px.x < v_aabb.x || px.y < v_aabb.y || px.x > v_aabb.z || px.y > v_aabb.w) discard;
 
     KilnInstance inst = kiln_instances[v_instance];

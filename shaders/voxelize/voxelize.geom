@@ -4,6 +4,9 @@
 // pixel diagonal so every voxel it touches gets a fragment (conservative rasterisation
 // after Hasselgren et al., GPU Gems 2 ch. 42). The enlarged corners' world positions
 // are extrapolated on the triangle's plane (the projection is affine, so this is exact).
+// Each axis draws into a viewport of its own, apart from the others by whole tiles of
+// llvmpipe's 64 × 64 (voxelize.cpp sets them up): a framebuffer as small as the voxels
+// is one tile, and llvmpipe shades a tile on one thread.
 layout(triangles) in;
 layout(triangle_strip, max_vertices = 3) out;
 
@@ -80,6 +83,7 @@ void main() {
         v_aabb = aabb;
         v_depthRange = depthRange;
         gl_Position = vec4(o[i], 0.0, 1.0);
+        gl_ViewportIndex = axis;
         EmitVertex();
     }
     EndPrimitive();
