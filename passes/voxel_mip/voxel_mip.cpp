@@ -25,7 +25,7 @@
 //          i.e. Σ d²·(the three chains facing d). Filtering is linear, so one lookup
 //          here equals cone_trace's three; the blend costs 12 writes per voxel of
 //          levels ≥ 1 (1/7 of the volume) once per voxel change instead of two more
-//          fetches per cone step per pixel.
+//          fetches per cone step per pixel. aniso.comp blends each level as it builds it.
 // Chains a mode does not build are cleared to zero once and left alone; binding one
 // is a pipeline error (producedWhen), so no cone reads them.
 //
@@ -167,12 +167,14 @@ public:
         // from the one before.
         const std::string& facingMode = ctx.getEnum("facing");
         const char* facing = facingMode == "back" ? "1" : facingMode == "back_and_edge" ? "2" : "0";
+        const char* blended = ctx.getEnum("mode") == "fixed_cones" ? "1" : "0";
         const AnisoPrograms aniso{
             ctx.program({.stages = {"voxel_mip/aniso.comp"},
-                         .defines = {{"KILN_ANISO_FROM_BASE", "1"}, {"KILN_ANISO_FACING", facing}}}),
-            ctx.program({.stages = {"voxel_mip/aniso.comp"}, .defines = {{"KILN_ANISO_FROM_BASE", "0"}}})};
-        GLuint blend = ctx.program({.stages = {"voxel_mip/fixed_cones.comp"}});
-        if (!iso || !aniso.fromBase || !aniso.fromLevel || !blend) return;
+                         .defines = {{"KILN_ANISO_FROM_BASE", "1"}, {"KILN_ANISO_FACING", facing},
+                                     {"KILN_ANISO_FIXED_CONES", blended}}}),
+            ctx.program({.stages = {"voxel_mip/aniso.comp"},
+                         .defines = {{"KILN_ANISO_FROM_BASE", "0"}, {"KILN_ANISO_FIXED_CONES", blended}}})};
+        if (!iso || !aniso.fromBase || !aniso.fromLevel) return;
         const kiln::TextureRef& in = ctx.input("radiance");
         const kiln::TextureRef& chain = ctx.output("iso");
         const int bounces = ctx.getInt("bounces");
@@ -211,7 +213,7 @@ public:
             keptId_ = 0;  // turned back on later: starts from nothing
             glCopyImageSubData(in.id, GL_TEXTURE_3D, 0, 0, 0, 0, chain.id, GL_TEXTURE_3D, 0, 0, 0, 0, res, res, res);
         }
-        buildChains(ctx, iso, aniso, blend);
+        buildChains(ctx, iso, aniso);
 
         // Each further bounce: gather through the chains just built into `bounced`, make
         // it level 0, rebuild the chains from it.
@@ -219,7 +221,7 @@ public:
             const kiln::TextureRef& bounced = ctx.internal("bounced");
             dispatchGather(ctx, bounce, bounced.id, chain.id);
             glCopyImageSubData(bounced.id, GL_TEXTURE_3D, 0, 0, 0, 0, chain.id, GL_TEXTURE_3D, 0, 0, 0, 0, res, res, res);
-            buildChains(ctx, iso, aniso, blend);
+            buildChains(ctx, iso, aniso);
         }
         if (feedback) {
             if (listed) listSurfaceBlocks(ctx, list, kept.id);
@@ -279,7 +281,7 @@ private:
     struct AnisoPrograms {
         GLuint fromBase = 0, fromLevel = 0;
     };
-    void buildChains(kiln::PassContext& ctx, GLuint iso, const AnisoPrograms& anisoPrograms, GLuint blend) {
+    void buildChains(kiln::PassContext& ctx, GLuint iso, const AnisoPrograms& anisoPrograms) {
         const kiln::TextureRef& chain = ctx.output("iso");
         const kiln::TextureRef& atlas = ctx.output("aniso");
         const kiln::TextureRef& fixed = ctx.output("fixed_cones");
@@ -295,8 +297,10 @@ private:
             glDispatchCompute(groups(n), groups(n), groups(n));
         }
 
+        const bool blended = mode == "fixed_cones";
         if (mode != "iso") {
-            // Directional level L (1 … log2 res) lives in atlas level L−1, octant side res>>L.
+            // Directional level L (1 … log2 res) lives in atlas level L−1, octant side res>>L;
+            // with fixed_cones, blended into the fixed chains' level L−1 as it is built.
             for (int L = 1; (res >> L) >= 1; ++L) {
                 const int n = res >> L;
                 const GLuint aniso = L == 1 ? anisoPrograms.fromBase : anisoPrograms.fromLevel;
@@ -307,6 +311,7 @@ private:
                 else
                     kiln::gl::bindImage(aniso, "u_src", atlas.id, L - 2, true, GL_READ_ONLY, GL_RGBA16F);
                 kiln::gl::bindImage(aniso, "u_dst", atlas.id, L - 1, true, GL_WRITE_ONLY, GL_RGBA16F);
+                if (blended) kiln::gl::bindImage(aniso, "u_fixed", fixed.id, L - 1, true, GL_WRITE_ONLY, GL_RGBA16F);
                 if (facing && L == 1) kiln::gl::bindTexture(aniso, "u_normal", ctx.input("normal").id);
                 glUniform1i(glGetUniformLocation(aniso, "u_size"), n);
                 glDispatchCompute(groups(n), groups(n), groups(n));
@@ -316,17 +321,7 @@ private:
             clearAllLevels(atlas);
             atlasCleared_ = true;
         }
-
-        if (mode == "fixed_cones") {
-            glUseProgram(blend);
-            for (int L = 1; (res >> L) >= 1; ++L) {
-                const int n = res >> L;
-                glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
-                kiln::gl::bindImage(blend, "u_aniso", atlas.id, L - 1, true, GL_READ_ONLY, GL_RGBA16F);
-                kiln::gl::bindImage(blend, "u_fixed", fixed.id, L - 1, true, GL_WRITE_ONLY, GL_RGBA16F);
-                glUniform1i(glGetUniformLocation(blend, "u_size"), n);
-                glDispatchCompute(groups(n), groups(n), groups(n));
-            }
+        if (blended) {
             fixedCleared_ = false;
         } else if (!fixedCleared_) {
             clearAllLevels(fixed);
