@@ -69,13 +69,15 @@ public:
             // The bodies are closed, so their back faces never show: culled, they cost
             // llvmpipe no setup (13.3 against 16.4 ms at 720²), and no back face wins a
             // depth tie at a silhouette (3 pixels of 360² did). The walls and the lamp's dome
-            // are open surfaces, seen from either side.
+            // are open surfaces, seen from either side. The bodies first: they stand in
+            // front of the walls, whose hidden fragments the depth test then rejects
+            // before shading (gbuffer 5.36 -> 5.21 ms at 720², three alternations).
             filter.categories &= ~kiln::kSceneBodies;
-            ctx.drawScene(filter);
             glEnable(GL_CULL_FACE);
             glCullFace(GL_BACK);
             ctx.drawScene({.categories = kiln::kSceneBodies});
             glDisable(GL_CULL_FACE);
+            ctx.drawScene(filter);
             // The floor, the one wood-grained instance (a wall of the box).
             glUseProgram(woodProgram);
             kiln::gl::bindTexture(woodProgram, "u_wood", wood.id);
