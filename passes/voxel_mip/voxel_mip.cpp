@@ -80,7 +80,7 @@ namespace {
 constexpr float kGatherStartOffset = 1.0f;
 constexpr float kGatherDiameterOffset = 0.5f;
 // A gather's three jobs (bounce.comp's KILN_BOUNCE_STEP).
-enum class BounceStep { GatherAndReflect = 0, GatherForNextFrame = 1, ReflectLastFrames = 2, ListSurfaceBlocks = 3 };
+enum class BounceStep { GatherAndReflect = 0, GatherForNextFrame = 1, ReflectLastFrames = 2 };
 
 // With feedback every frame adds `bounces` bounces to what the voxels converge to; the
 // share of light still to come shrinks by about the surfaces' albedo a bounce (0.5 in
@@ -193,9 +193,8 @@ public:
         const GLuint bounce = bounces > 1 ? gatherProgram(BounceStep::GatherAndReflect) : 0;
         const GLuint keep = feedback ? gatherProgram(BounceStep::GatherForNextFrame) : 0;
         const bool listed = feedback && ctx.getBool("gather_list");
-        const GLuint list = listed ? gatherProgram(BounceStep::ListSurfaceBlocks) : 0;
         const GLuint reflectKept = feedback ? gatherProgram(BounceStep::ReflectLastFrames) : 0;
-        if ((bounces > 1 && !bounce) || (feedback && !(keep && reflectKept)) || (listed && !list)) return;
+        if ((bounces > 1 && !bounce) || (feedback && !(keep && reflectKept))) return;
         glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
 
         // Level 0: the input, or with feedback the input plus what its surfaces reflect
@@ -208,6 +207,7 @@ public:
                 keptId_ = kept.id;
                 keptRes_ = kept.width;
             }
+            if (listed) startGatherList(ctx);  // the reflection lists the blocks to gather at
             dispatchGather(ctx, reflectKept, chain.id, 0);
         } else {
             keptId_ = 0;  // turned back on later: starts from nothing
@@ -224,7 +224,6 @@ public:
             buildChains(ctx, iso, aniso);
         }
         if (feedback) {
-            if (listed) listSurfaceBlocks(ctx, list, kept.id);
             dispatchGather(ctx, keep, kept.id, chain.id, listed);
             ctx.keepRunning(kFeedbackSettleFrames, "voxel bounces fed back");
         }
@@ -233,21 +232,20 @@ public:
 private:
     static GLuint groups(int n) { return GLuint((n + 3) / 4); }
 
-    // The blocks that hold a surface, listed in gatherList_ for an indirect dispatch of
-    // the gather (bounce.comp step 3), and nothing kept at every other block.
-    void listSurfaceBlocks(kiln::PassContext& ctx, GLuint program, GLuint kept) {
+    // gatherList_ emptied, for the reflection of the kept gather (bounce.comp step 2) to
+    // list the blocks that hold a surface for the gather's indirect dispatch (step 1).
+    void startGatherList(kiln::PassContext& ctx) {
         const int blocks = ctx.output("iso").width / ctx.getInt("gather_block");
         const GLsizeiptr bytes = 16 + 4 * GLsizeiptr(blocks) * blocks * blocks;
         if (!gatherList_ || gatherList_.size() < bytes)
             gatherList_ = kiln::gl::Buffer::create(bytes, nullptr, GL_DYNAMIC_STORAGE_BIT, "voxel_mip.gather_list");
         const GLuint empty[4] = {0, 1, 1, 0};  // no groups yet, 1 × 1; nothing listed
         glNamedBufferSubData(gatherList_.id(), 0, sizeof empty, empty);
-        dispatchGather(ctx, program, kept, 0);
     }
 
     // One bounce.comp dispatch over the voxels' blocks, writing `target`'s level 0;
     // `chainsRead` (iso) and the other chains are what its cones trace, if it gathers.
-    // `listed`: over the blocks listSurfaceBlocks found, an indirect dispatch.
+    // `listed`: over the blocks step 2 listed, an indirect dispatch.
     void dispatchGather(kiln::PassContext& ctx, GLuint program, GLuint target, GLuint chainsRead, bool listed = false) {
         const int res = ctx.output("iso").width;
         glUseProgram(program);
@@ -264,6 +262,7 @@ private:
             kiln::gl::bindTexture(program, "u_fixedCones", ctx.output("fixed_cones").id);
         }
         kiln::gl::bindImage(program, "u_bounced", target, 0, true, GL_WRITE_ONLY, GL_RGBA16F);
+        kiln::gl::bindImage(program, "u_forgotten", ctx.internal("feedback").id, 0, true, GL_WRITE_ONLY, GL_RGBA16F);
         if (gatherList_) kiln::gl::bindStorageBuffer(program, "GatherList", gatherList_.id());
         if (listed) {
             glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, gatherList_.id());

@@ -14,13 +14,14 @@
 // (1/4: the mean of max(n·d, 0) over the sphere), normalised over the cones traced.
 // KILN_BOUNCE_STEP: 0 = gather and reflect (the above, into u_bounced); with feedback
 // (voxel_mip's `feedback`), 1 = gather only, kept as Ē per voxel for the next frame, and
-// 2 = no gather: L = L_0 + albedo · (that kept Ē), the frame's starting level 0.
-// 3 = list the blocks that hold a reflecting surface (their indices in GatherList, the
-// dispatch size of a 64-wide pass over them beside it) and write the kept gather of
-// every other block: nothing, what step 1 would have gathered there. Step 1 with
-// KILN_GATHER_LIST then runs over the list only: llvmpipe runs a compute shader's loop
-// for all 8 lanes of a SIMD vector while any one has work, and every row of 8 blocks
-// meets a side wall, so over the whole grid every block paid a surface's cones.
+// 2 = no gather: L = L_0 + albedo · (that kept Ē), the frame's starting level 0; with
+// KILN_GATHER_LIST it also lists the blocks that hold a reflecting surface (their indices
+// in GatherList, the dispatch size of a 64-wide pass over them beside it) and writes the
+// kept gather of every other block: nothing, what step 1 would have gathered there. Step
+// 1 with KILN_GATHER_LIST then runs over the list only: llvmpipe runs a compute shader's
+// loop for all 8 lanes of a SIMD vector while any one has work, and every row of 8 blocks
+// meets a side wall, so over the whole grid every block paid a surface's cones. (The
+// list was a dispatch of its own, which read the same voxels again: 0.3 ms at 720².)
 // fixed_cones.glsl first: trace.glsl's voxels.glsl includes it only inside
 // `#if KILN_HAS_FIXED_CONES`, and a file is included once per stage.
 #include "common/fixed_cones.glsl"
@@ -32,7 +33,7 @@ layout(local_size_x = 64) in;
 layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
 #endif
 #if KILN_GATHER_LIST
-// Filled by step 3, read by step 1; `dispatch` is glDispatchComputeIndirect's (x, y, z).
+// Filled by step 2, read by step 1; `dispatch` is glDispatchComputeIndirect's (x, y, z).
 layout(std430, binding = 2) buffer GatherList {
     uint u_dispatch[3];
     uint u_listed;
@@ -44,6 +45,11 @@ layout(binding = 1) uniform sampler3D u_albedo;   // voxelize.albedo
 layout(binding = 4) uniform sampler3D u_normal;   // voxelize.normal
 layout(binding = 5) uniform sampler3D u_gathered;  // KILN_BOUNCE_STEP 2: the last frame's step 1
 layout(rgba16f, binding = 0) uniform writeonly image3D u_bounced;
+#if KILN_BOUNCE_STEP == 2 && KILN_GATHER_LIST
+// The same texture as u_gathered: each invocation empties only its own block's voxels,
+// after reading them.
+layout(rgba16f, binding = 1) uniform writeonly image3D u_forgotten;
+#endif
 
 const int kBlock = KILN_GATHER_BLOCK;
 
@@ -102,24 +108,21 @@ vec4 reflecting(ivec3 v, vec3 incoming) {
     return radiance;
 }
 
-#if KILN_BOUNCE_STEP == 3
-void main() {
-    ivec3 block = ivec3(gl_GlobalInvocationID);
-    if (any(greaterThanEqual(block * kBlock, ivec3(int(u_voxelRes))))) return;
-    bool surface = false;
-    for (int i = 0; i < kBlock * kBlock * kBlock; ++i) {
-        ivec3 v = voxelOf(block, i);
-        surface = surface || reflects(texelFetch(u_emitted, v, 0), texelFetch(u_albedo, v, 0).rgb);
-    }
+#if KILN_BOUNCE_STEP == 2 && KILN_GATHER_LIST
+// Step 1 gathers at `block` (a reflecting surface is in it); or, none being there, what
+// it would have gathered is nothing.
+void listOrForget(ivec3 block, bool surface) {
     if (surface) {
         uint index = atomicAdd(u_listed, 1u);
         u_blocks[index] = uint(block.x) | uint(block.y) << 10 | uint(block.z) << 20;
         if (index % 64u == 0u) atomicAdd(u_dispatch[0], 1u);  // one more 64-wide group
     } else {
-        for (int i = 0; i < kBlock * kBlock * kBlock; ++i) imageStore(u_bounced, voxelOf(block, i), vec4(0.0, 0.0, 0.0, 1.0));
+        for (int i = 0; i < kBlock * kBlock * kBlock; ++i)
+            imageStore(u_forgotten, voxelOf(block, i), vec4(0.0, 0.0, 0.0, 1.0));
     }
 }
-#else
+#endif
+
 void main() {
 #if KILN_GATHER_LIST && KILN_BOUNCE_STEP == 1
     if (gl_GlobalInvocationID.x >= u_listed) return;
@@ -133,6 +136,7 @@ void main() {
 #if KILN_BOUNCE_STEP != 2
     vec3 gathered = gatherBlock(block);
 #endif
+    bool surface = false;
     for (int i = 0; i < kBlock * kBlock * kBlock; ++i) {
         ivec3 v = voxelOf(block, i);
 #if KILN_BOUNCE_STEP == 0
@@ -143,7 +147,10 @@ void main() {
 #else
         // The last frame's gather (feedback), reflected: this frame's level 0.
         imageStore(u_bounced, v, reflecting(v, texelFetch(u_gathered, v, 0).rgb));
+        surface = surface || reflects(texelFetch(u_emitted, v, 0), texelFetch(u_albedo, v, 0).rgb);
 #endif
     }
-}
+#if KILN_BOUNCE_STEP == 2 && KILN_GATHER_LIST
+    listOrForget(block, surface);
 #endif
+}
