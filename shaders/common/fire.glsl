@@ -1,8 +1,8 @@
 // The lamp's light through the fire (voxelize's fire_cover on): the fraction of the lamp
 // a point sees past the fireballs and their particles, which the shadow map (drawn
 // without them, from one point of the lamp) cannot hide it by. The lamp is large, so
-// it changes slowly away from the fire: voxelize evaluates it on a grid half its
-// voxels' resolution (voxelize/fire_transmittance.comp, `lamp_transmittance`), which
+// it changes slowly away from the fire: voxelize evaluates it on a coarser grid than its
+// voxels (transmittance_resolution; voxelize/fire_transmittance.comp, `lamp_transmittance`), which
 // the voxels' lamp light (voxelize/resolve.comp) and cone_trace's traced pixels (alpha,
 // for composite's lamp_through_fire) look up. For the particles' cone the lamp, as p
 // sees it, is a disc of its apparent area: |d.y| of its rim's disc (from below) plus the

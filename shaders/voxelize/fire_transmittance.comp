@@ -1,6 +1,6 @@
 #version 450 core
-// fire_cover: `lamp_transmittance`, the fraction of the lamp each node of a grid half the
-// voxels' resolution sees past the fire (common/fire.glsl: the fireballs exactly, the
+// fire_cover: `lamp_transmittance`, the fraction of the lamp each node of a grid of
+// voxelize's transmittance_resolution³ sees past the fire (common/fire.glsl: the fireballs exactly, the
 // particles through `fire`), facing the lamp. resolve.comp takes each voxel's lamp light
 // through it and cone_trace each traced pixel's: one lookup where a march per voxel cost
 // voxelize 7 -> 13 ms at 720² on llvmpipe. The lamp is large, so the fraction changes
