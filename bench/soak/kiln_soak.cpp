@@ -353,6 +353,7 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "kiln-soak: error: %s\n", error.c_str());
         return 1;
     }
+    app.runtime().readEverything = true;  // every texture is checked, so every output is written
     Soak soak(app, *options, files);
     soak.run();
     const std::vector<std::string> problems = soak.problems();

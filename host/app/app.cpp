@@ -56,9 +56,10 @@ bool App::init(const Options& o, std::string& error) {
     ro.width = o.width;
     ro.height = o.height;
     if (!runtime_.init(ro, error)) return false;
+    runtime_.readEverything = o.headless && !o.dump.empty();  // --dump writes every texture
     if (!scene_.load(o.scene, seedOverride(), error)) return false;
-    if (!viewed.empty()) runtime_.setRequested({viewed});
-    requestedView_ = viewed;
+    requested_ = requestedTextures();
+    runtime_.setRequested(requested_);
     std::string errors;
     if (!runtime_.loadPipeline(o.pipeline, errors)) {
         if (!errors.empty() && errors.back() == '\n') errors.pop_back();
@@ -190,11 +191,19 @@ int App::settle(int maxFrames) {
     return frames;
 }
 
+std::vector<std::string> App::requestedTextures() const {
+    std::vector<std::string> out;
+    if (!viewed.empty()) out.push_back(viewed);
+    for (const std::string& t : alsoRead)
+        if (!t.empty() && std::find(out.begin(), out.end(), t) == out.end()) out.push_back(t);
+    return out;
+}
+
 void App::frame(double wallSeconds) {
     live_.poll(*this);  // edits land at a frame boundary, on this thread
-    if (viewed != requestedView_) {
-        requestedView_ = viewed;
-        runtime_.setRequested(viewed.empty() ? std::vector<std::string>{} : std::vector<std::string>{viewed});
+    if (std::vector<std::string> requested = requestedTextures(); requested != requested_) {
+        requested_ = requested;
+        runtime_.setRequested(std::move(requested));
     }
     if (scene_.time() < lastSimTime_) droppedSeconds = 0.0;  // reset (R) or a reloaded scene
     const auto stepStart = std::chrono::steady_clock::now();

@@ -61,6 +61,9 @@ public:
     // "pass.output" or empty for the graph output. Viewing a texture un-culls its
     // producer (from the next frame on), as --view does.
     std::string viewed;
+    // More textures something outside the graph reads (the compare view's two): asked
+    // for, so their producers run and write them (PassContext::isRead).
+    std::vector<std::string> alsoRead;
 
     // Frames in which only bodies moved redraw part of the picture (--full-redraw: off).
     bool redrawParts = true;
@@ -69,6 +72,7 @@ public:
 
 private:
     SceneView buildView();
+    std::vector<std::string> requestedTextures() const;  // viewed, then alsoRead
     void chooseRedraw(const SceneView&, FrameInfo&);
 
     int stepRealTime(double wallSeconds, std::chrono::steady_clock::time_point start);
@@ -87,7 +91,7 @@ private:
     FrameInfo lastFrame_;
     double accumulator_ = 0.0;
     double lastSimTime_ = 0.0;   // the scene's time after the last frame (a smaller one: reset or reload)
-    std::string requestedView_;  // what the runtime was last asked to keep un-culled
+    std::vector<std::string> requested_;  // what the runtime was last asked to keep un-culled and written
     int refusedWidth_ = 0, refusedHeight_ = 0;  // a size the runtime refused
 };
 

@@ -231,6 +231,9 @@ int runWindow(const Options& o) {
         followBudget(state, std::chrono::duration<double>(now - start).count());
         app.resize(std::max(1, int(std::lround(state.image.z * state.renderScale))),
                    std::max(1, int(std::lround(state.image.w * state.renderScale))));
+        // What the compare view reads is asked for, so it is written.
+        app.alsoRead = state.compare.on ? std::vector<std::string>{state.compare.a, state.compare.b}
+                                        : std::vector<std::string>{};
         // The first frame steps once, as headless does; then the wall clock leads.
         app.frame(frames == 1 ? -1.0 : wall);
         drawImage(state, fbW, fbH);

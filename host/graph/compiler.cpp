@@ -646,7 +646,11 @@ private:
     void cull() {
         const size_t n = plan_.passes.size();
         std::vector<bool> live(n, false);
-        if (plan_.output.valid()) live[static_cast<size_t>(plan_.output.pass)] = true;
+        for (PlannedPass& pp : plan_.passes) pp.outputRead.assign(pp.decl.outputs.size(), false);
+        if (plan_.output.valid()) {
+            live[static_cast<size_t>(plan_.output.pass)] = true;
+            markRead(plan_.output.pass, plan_.output.name);
+        }
         for (const std::string& r : opt_.requested) {
             const std::string what = "viewed texture " + q(r);
             std::string id, name;
@@ -675,6 +679,7 @@ private:
             }
             live[static_cast<size_t>(j)] = true;
             plan_.requested.push_back(r);
+            markRead(j, name);
         }
         for (size_t i = n; i-- > 0;) {
             if (!live[i] || !enabled(static_cast<int>(i))) continue;
@@ -694,6 +699,17 @@ private:
                 pp.state = PassState::Run;
             }
         }
+        for (const PlannedPass& pp : plan_.passes)
+            if (pp.runs())
+                for (const Binding& b : pp.bindings)
+                    if (b.bound()) markRead(b.producer, b.output);
+    }
+
+    // Output `name` of pass j is read (an internal texture's name: nothing to mark).
+    void markRead(int j, const std::string& name) {
+        PlannedPass& pp = plan_.passes[static_cast<size_t>(j)];
+        for (size_t k = 0; k < pp.decl.outputs.size(); ++k)
+            if (pp.decl.outputs[k].name == name) pp.outputRead[k] = true;
     }
 
     // Stage 4: signatures. Producers are named by id, so a change upstream does not

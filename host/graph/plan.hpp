@@ -71,6 +71,9 @@ struct PlannedPass {
     std::string reason;             // why culled/disabled; "" for Run
     std::string signature;          // readable; equal signatures ⇒ same textures
     uint64_t signatureHash = 0;     // FNV-1a of `signature`
+    // Parallel to decl.outputs: whether something reads the output — a running pass
+    // bound to it, the graph output, a requested texture (PassContext::isRead).
+    std::vector<bool> outputRead;
 
     bool runs() const { return state == PassState::Run; }
     const Binding* binding(std::string_view slot) const;

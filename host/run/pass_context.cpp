@@ -34,6 +34,14 @@ bool HostPassContext::isBound(std::string_view name) const {
     return b && b->bound();
 }
 
+bool HostPassContext::isRead(std::string_view name) const {
+    for (size_t k = 0; k < planned_.decl.outputs.size(); ++k)
+        if (planned_.decl.outputs[k].name == name)
+            return shared_.readEverything || (k < planned_.outputRead.size() && planned_.outputRead[k]);
+    missing("output", name);
+    return true;
+}
+
 const ParamValue& HostPassContext::param(std::string_view name) const {
     if (const ParamValue* v = planned_.params.find(name)) return *v;
     static const ParamValue none = 0.0f;

@@ -32,6 +32,7 @@ struct FrameResources {
     const ShaderLibrary& shaders;
     const SceneDraw& scene;
     GLuint emptyVao;
+    bool readEverything = false;  // every output counts as read (Runtime::readEverything)
 };
 
 class HostPassContext final : public PassContext {
@@ -59,6 +60,7 @@ public:
     void nothingToDo(std::string_view reason) override { nothing_ = std::string(reason); }
     void fail(std::string_view message) override;
     void keepRunning(int frames, std::string_view reason) override;
+    bool isRead(std::string_view output) const override;
 
     bool failed() const { return failed_; }
     const std::optional<std::string>& nothing() const { return nothing_; }

@@ -246,8 +246,9 @@ bool Runtime::resize(int width, int height, std::string& error) {
 std::vector<uint64_t> Runtime::runKey(const graph::PlannedPass& planned, const PassSlot& slot,
                                       const SceneView& view) const {
     // Everything whose change must make the pass run again: each input's version
-    // (0 for a fallback), each scene category it reads, the output size, and the
-    // generation of its programs (a rebuilt program runs the pass again).
+    // (0 for a fallback), each scene category it reads, the output size, the
+    // generation of its programs (a rebuilt program runs the pass again), and which of
+    // its outputs are read (one it left unwritten must be written once read).
     std::vector<uint64_t> key;
     for (auto& b : planned.bindings) {
         uint64_t version = 0;
@@ -262,6 +263,10 @@ std::vector<uint64_t> Runtime::runKey(const graph::PlannedPass& planned, const P
         key.push_back((planned.decl.reads & (1u << i)) ? view.versions[i] : 0);
     key.push_back(static_cast<uint64_t>(options_.width) << 32 | static_cast<uint32_t>(options_.height));
     key.push_back(slot.programs.generation());
+    uint64_t read = 0;
+    for (size_t k = 0; k < planned.outputRead.size() && k < 64; ++k)
+        if (readEverything || planned.outputRead[k]) read |= uint64_t(1) << k;
+    key.push_back(read);
     return key;
 }
 
@@ -336,7 +341,7 @@ void Runtime::renderFrame(const SceneView& view, const SceneDraw& scene, const F
     glNamedBufferSubData(frameUniforms_.id(), 0, sizeof(GpuFrame), &gpuFrame);
     collectGpuTimes();
     if (!plan_) return;
-    const FrameResources shared{slots_, fallbacks_, *shaders_, scene, emptyVao_.id()};
+    const FrameResources shared{slots_, fallbacks_, *shaders_, scene, emptyVao_.id(), readEverything};
     glGetIntegerv(GL_DEBUG_GROUP_STACK_DEPTH, &frameGroupDepth_);  // a faulted pass's groups are popped to it
     for (size_t i = 0; i < slots_.size(); ++i) runPass(i, shared, view, frame);
     recoverFromFaults();
@@ -509,8 +514,17 @@ std::vector<PassRow> Runtime::stats() const {
 
 std::vector<NamedTexture> Runtime::textures() const {
     std::vector<NamedTexture> out;
-    for (auto& s : slots_)
-        for (auto& [name, t] : s->textures) out.push_back({s->id, name, t.internal, t.ref, t.decl.depthNear, t.decl.depthFar, t.decl.size.tiles});
+    for (size_t i = 0; i < slots_.size(); ++i) {
+        const PassSlot& s = *slots_[i];
+        const graph::PlannedPass* planned = plan_ && i < plan_->passes.size() ? &plan_->passes[i] : nullptr;
+        for (auto& [name, t] : s.textures) {
+            bool read = true;
+            if (planned && !t.internal && !readEverything)
+                for (size_t k = 0; k < planned->decl.outputs.size() && k < planned->outputRead.size(); ++k)
+                    if (planned->decl.outputs[k].name == name) read = planned->outputRead[k];
+            out.push_back({s.id, name, t.internal, t.ref, t.decl.depthNear, t.decl.depthFar, t.decl.size.tiles, read});
+        }
+    }
     return out;
 }
 

@@ -70,6 +70,8 @@ public:
     void resetTimings();
     // Runs every pass every frame regardless of versions (timing runs).
     bool alwaysRun = false;
+    // Every output counts as read (PassContext::isRead): a dump writes them all.
+    bool readEverything = false;
     // A pass has frames left that it asked for with keepRunning (its output is still
     // converging with nothing changed upstream).
     bool settling() const;

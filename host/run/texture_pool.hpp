@@ -71,6 +71,7 @@ struct NamedTexture {
     TextureRef ref;
     float depthNear = 0.0f, depthFar = 0.0f;  // TextureDecl's: how to linearise a depth texture
     int tiles = 1;                             // blocks side by side along x (SizeRule::tiles)
+    bool read = true;  // false: an output nothing reads, which its pass may leave unwritten (PassContext::isRead)
 };
 
 // Writes `image`, read back from a texture of `internalFormat`, as BASE.png (clamped to

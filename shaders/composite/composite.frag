@@ -17,10 +17,18 @@
 #ifndef KILN_DIRECT
 #define KILN_DIRECT 0
 #endif
+#ifndef KILN_HDR
+#define KILN_HDR 1
+#endif
+// KILN_HDR 0: nothing reads `hdr` (PassContext::isRead), which is then not a target.
 layout(location = 0) out vec4 o_color;
+#if KILN_HDR
 layout(location = 1) out vec4 o_hdr;
-#if KILN_DIRECT == 1
+#endif
+#if KILN_DIRECT == 1 && KILN_HDR
 layout(location = 2) out vec4 o_direct;
+#elif KILN_DIRECT == 1
+layout(location = 1) out vec4 o_direct;
 #endif
 #if KILN_DIRECT == 2
 layout(binding = 9) uniform sampler2D u_direct;
@@ -211,7 +219,9 @@ void main() {
     o_direct = vec4(lampLit, mod(u_time.z, 1024.0) + 1.0);  // a: the frame that computed it (mod 1024) + 1
 #endif
     vec3 radiance = shade(px, uv, lampLit, albedo);
+#if KILN_HDR
     o_hdr = vec4(radiance, 1.0);
+#endif
     vec3 shown = (radiance + texture(u_bloom, uv).rgb) * u_exposure;
     o_color = vec4(displayEncode(shown, u_tonemap, u_gamma), 1.0);
 }

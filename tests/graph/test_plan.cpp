@@ -72,6 +72,33 @@ TEST_CASE("file order is execution order, also when reordered", "[plan]") {
     CHECK(ids == std::vector<std::string>{"gbuffer", "bloom", "shadow", "composite"});
 }
 
+TEST_CASE("an output is read when a running pass binds it, it is the graph output, or it is viewed", "[plan][cull]") {
+    // composite takes gbuffer.albedo for its normal too; the only other reader of
+    // gbuffer.normal is bloom, culled (nothing reads bloom.color).
+    const std::string json = R"({ "output": "composite.color", "passes": [
+        { "id": "gbuffer", "module": "gbuffer" },
+        { "id": "bloom", "module": "bloom", "inputs": { "color": "gbuffer.normal" } },
+        { "id": "composite", "module": "composite", "inputs": { "albedo": "gbuffer.albedo",
+          "normal": "gbuffer.albedo", "depth": "gbuffer.depth" } } ] })";
+    auto read = [](const Plan& p, const std::string& id) { return pass(p, id).outputRead; };
+    const Plan p = compileOk(json);
+    REQUIRE(pass(p, "bloom").state == PassState::Culled);
+    CHECK(read(p, "gbuffer") == std::vector<bool>{true, false, true});  // albedo, normal, depth
+    CHECK(read(p, "bloom") == std::vector<bool>{false});
+    CHECK(read(p, "composite") == std::vector<bool>{true});
+    CHECK_THAT(p.table(), Contains("normal rgba16f 1x unread"));
+    CHECK_THAT(p.table(), !Contains("albedo rgba8 1x unread"));
+
+    // Viewing bloom's output runs bloom, which reads gbuffer.normal; viewing an internal
+    // texture marks no output.
+    const Plan viewed = compileOk(json, {"bloom.color", "bloom.ping"});
+    CHECK(read(viewed, "gbuffer") == std::vector<bool>{true, true, true});
+    CHECK(read(viewed, "bloom") == std::vector<bool>{true});
+    const Plan normalViewed = compileOk(json, {"gbuffer.normal"});
+    CHECK(read(normalViewed, "gbuffer") == std::vector<bool>{true, true, true});
+    CHECK(pass(normalViewed, "bloom").state == PassState::Culled);
+}
+
 TEST_CASE("a pass feeding nothing is culled, and viewing its texture un-culls it", "[plan][cull]") {
     const Plan p = compileOk(kBasicPipeline);
     const PlannedPass& bloom = pass(p, "bloom");

@@ -24,6 +24,7 @@ TEST_CASE("default pipeline: left wall reads orange, right wall sky blue", "[int
     app::App app;
     std::string error;
     REQUIRE(app.init(test::pausedHeadlessOptions(128), error));
+    app.runtime().setRequested({"composite.hdr"});  // written only when something reads it
     app.frame();
     // The hue is judged on linear radiance (composite.hdr): bounce light and the
     // tonemap's shoulder desaturate the final image, not the order of the channels.

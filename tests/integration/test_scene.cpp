@@ -45,6 +45,9 @@ struct Rig {
         o.seed = 1;
         std::string error;
         REQUIRE(app.init(o, error));
+        // The tests read the radiance: asked for, as the error metrics ask (composite
+        // writes `hdr` only when something reads it).
+        app.runtime().setRequested({"composite.hdr"});
     }
     glm::vec2 pixelOf(const glm::vec3& world, int size) {
         glm::mat4 vp = app.camera().projection(1.0f) * app.camera().view();
@@ -59,6 +62,60 @@ struct Rig {
 };
 
 }  // namespace
+
+TEST_CASE("composite writes `hdr` only while something reads it, and in full as soon as something does",
+          "[scene][gl]") {
+    // The default pipeline, paused and settled (the voxels' bounces converged); nothing
+    // reads composite.hdr until it is requested. A sentinel cleared into it first (a
+    // negative radiance, which no frame writes) shows whether a frame wrote it.
+    REQUIRE(test::ensureHeadlessContext());
+    auto image = [](app::App& app, const char* pass, const char* name) {
+        const TextureRef* t = app.runtime().findTexture(pass, name);
+        REQUIRE(t);
+        return readTexture(t->id, t->target, t->format, t->width, t->height);
+    };
+    const float sentinel[4] = {-3.25f, -3.25f, -3.25f, -3.25f};
+    std::string error;
+    app::App app;
+    REQUIRE(app.init(test::pausedHeadlessOptions(96), error));
+    app.frame();
+    app.settle();
+    const TextureRef* hdr = app.runtime().findTexture("composite", "hdr");
+    REQUIRE(hdr);
+    glClearTexImage(hdr->id, 0, GL_RGBA, GL_FLOAT, sentinel);
+    std::string why;
+    REQUIRE(app.runtime().setParam("composite", "exposure", ParamValue(1.5f), why));  // composite runs again
+    app.frame();
+    const FloatImage unread = image(app, "composite", "hdr"), shownUnread = image(app, "composite", "color");
+    size_t untouched = 0;
+    for (float v : unread.pixels) untouched += v == -3.25f;
+    CHECK(untouched == unread.pixels.size());  // not written
+
+    // Requested: the next frame writes it, though the paused scene changed nothing.
+    app.runtime().setRequested({"composite.hdr"});
+    app.frame();
+    const FloatImage read = image(app, "composite", "hdr"), shownRead = image(app, "composite", "color");
+    // The same as an app that asked for it from the start.
+    app::App fresh;
+    app::Options o = test::pausedHeadlessOptions(96);
+    o.view = "composite.hdr";
+    REQUIRE(fresh.init(o, error));
+    REQUIRE(fresh.runtime().setParam("composite", "exposure", ParamValue(1.5f), why));
+    fresh.frame();
+    fresh.settle();
+    const FloatImage expected = image(fresh, "composite", "hdr");
+    REQUIRE(read.pixels.size() == expected.pixels.size());
+    size_t differ = 0, sentinels = 0;
+    for (size_t i = 0; i < read.pixels.size(); ++i) {
+        differ += read.pixels[i] != expected.pixels[i];
+        sentinels += read.pixels[i] == -3.25f;
+    }
+    CHECK(sentinels == 0);
+    CHECK(differ == 0);
+    // And the picture is the same whether or not `hdr` was written.
+    REQUIRE(shownRead.pixels.size() == shownUnread.pixels.size());
+    CHECK(std::equal(shownRead.pixels.begin(), shownRead.pixels.end(), shownUnread.pixels.begin()));
+}
 
 TEST_CASE("a floor point in a tumbler's shadow is darker than its lit neighbour", "[scene][gl]") {
     Rig rig(oneTumblerScene());

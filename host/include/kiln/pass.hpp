@@ -104,6 +104,13 @@
 //   pass of a frame: a copy of it kept by the pass tells what moved since its last run
 //   (composite's direct light: passes/composite).
 //
+// OUTPUTS NOBODY READS
+//   ctx.isRead("output") is false when nothing reads that output this frame: no running
+//   pass binds it, it is not the graph output, and neither the debug view, a dump nor a
+//   tool asked for it (the host's requested textures). A pass may leave such an output
+//   unwritten (composite's `hdr`, which only the error metrics read); what it holds is
+//   then undefined. When something starts reading it, the pass runs again in full.
+//
 // EXECUTING
 //   ctx.input/output/internal("name") give a TextureRef (GL name + shape); asking for
 //   a name you did not declare fails the pass with a message naming it.
@@ -217,8 +224,9 @@ namespace kiln {
 // between passes; 7: GpuFrame::boxWalls; 8: PassContext::keepRunning; 9:
 // SizeRule::capSource and Lod::Medium; 10: ProgramBuild::portability; 11:
 // FrameInfo::redraw; 12: TextureRef::setup; 13: Lod::Fine, and Lod::High's tumblers by
-// their size on screen), so a module built for other terms is refused by name, not run.
-inline constexpr uint32_t kPassAbiVersion = 13;
+// their size on screen; 14: PassContext::isRead), so a module built for other terms is
+// refused by name, not run.
+inline constexpr uint32_t kPassAbiVersion = 14;
 
 struct TextureRef {
     GLuint id = 0;
@@ -275,6 +283,8 @@ public:
     virtual void nothingToDo(std::string_view reason) = 0;
     virtual void fail(std::string_view message) = 0;
     virtual void keepRunning(int frames, std::string_view reason) = 0;
+    // Whether anything reads `output` this frame (OUTPUTS NOBODY READS).
+    virtual bool isRead(std::string_view output) const = 0;
 
     float getFloat(std::string_view n) const { return std::get<float>(param(n)); }
     int getInt(std::string_view n) const { return std::get<int>(param(n)); }
