@@ -90,6 +90,7 @@ const char* const kDefaultSweeps[] = {
     "voxel_mip.feedback=false,true",  "voxel_mip.gather_diameter_offset=1,1.25,1.5",
     "composite.lamp_model=field,contour,points",
     "shadow.caster_mesh=fine,medium,coarse", "voxelize.tumbler_mode=mesh,splat", "voxelize.lamp_model=field,points",
+    "voxelize.transmittance_resolution=8,16,32",
 };
 
 struct Args {
