@@ -239,7 +239,8 @@ std::vector<std::vector<std::string>> tableRow(const std::vector<PlannedPass>& p
     for (size_t k = 0; k < p.decl.outputs.size(); ++k) {
         const TextureDecl& t = p.decl.outputs[k];
         const bool unread = p.runs() && k < p.outputRead.size() && !p.outputRead[k];
-        outputs.push_back(t.name + " " + toString(t.format) + " " + describeSize(t, p.params) + (unread ? " unread" : ""));
+        outputs.push_back(t.name + " " + toString(t.format) + " " + describeSize(t, p.params) +
+                          (unread ? " unread" : ""));
     }
     for (const TextureDecl& t : p.decl.internals)
         outputs.push_back(t.name + " " + toString(t.format) + " " + describeSize(t, p.params) + " internal");

@@ -302,7 +302,8 @@ private:
             fboSize_ = res;
         }
         glBindFramebuffer(GL_FRAMEBUFFER, fbo_.id());
-        for (GLuint axis = 0; axis < 3; ++axis) glViewportIndexedf(axis, float(axis) * axisStep, 0.0f, float(res), float(res));
+        for (GLuint axis = 0; axis < 3; ++axis)
+            glViewportIndexedf(axis, float(axis) * axisStep, 0.0f, float(res), float(res));
         glDisable(GL_DEPTH_TEST);
         glDisable(GL_CULL_FACE);
         glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
