@@ -25,10 +25,12 @@ if(kiln_passes)
   install(TARGETS ${kiln_passes} LIBRARY DESTINATION ${KILN_INSTALL_MODULEDIR})
 endif()
 
-# Only what a pass sees: kiln/pass.hpp and what it includes, and the hash a pass may key
-# its caches with. The host's own headers stay in the tree.
+# Only what a pass sees: kiln/pass.hpp and what it includes, the hash a pass may key
+# its caches with, and the display gamma's fit for a pass that tonemaps. The host's own
+# headers stay in the tree.
 install(FILES host/include/kiln/pass.hpp host/include/kiln/declare.hpp host/include/kiln/gl.hpp
               host/include/kiln/scene_view.hpp host/include/kiln/shader.hpp host/include/kiln/hash.hpp
+              host/include/kiln/gamma_fit.hpp
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/kiln)
 if(KILN_WITH_GL)
   install(DIRECTORY ${CMAKE_BINARY_DIR}/glad/include/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/kiln/loader)

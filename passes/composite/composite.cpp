@@ -14,6 +14,7 @@
 // casters are (kiln/pass.hpp, REUSING WHAT DID NOT CHANGE); anything else that changed
 // upstream (TextureRef::setup), the camera, the lamp, the box, a parameter, a program
 // or a size recomputes every pixel.
+#include <kiln/gamma_fit.hpp>
 #include <kiln/pass.hpp>
 
 #include <algorithm>
@@ -110,6 +111,9 @@ public:
         // `hdr` only when something reads it (the error metrics, the debug view): 0.6 ms
         // at 720² on llvmpipe for a target nothing in the default pipeline reads.
         hdr_ = ctx.isRead("hdr");
+        // The display's gamma as a polynomial where it fits (kiln/gamma_fit.hpp).
+        if (ctx.getFloat("gamma") != fittedGamma_)
+            fittedGamma_ = ctx.getFloat("gamma"), gammaFit_ = kiln::fitGamma(fittedGamma_);
         auto variant = [&](bool nearField, int direct, bool tiles) {
             return ctx.program({.stages = {tiles ? "composite/tiles.vert" : "common/fullscreen.vert", "composite/composite.frag"},
                                 .defines = {{"KILN_LAMP_SAMPLES", std::to_string(ctx.getInt("lamp_samples"))},
@@ -122,7 +126,8 @@ public:
                                             {"KILN_LAMP_THROUGH_FIRE", ctx.getBool("lamp_through_fire") ? "1" : "0"},
                                             {"KILN_FIREBALLS_ANALYTIC", ctx.getEnum("fireball_light") == "analytic" ? "1" : "0"},
                                             {"KILN_DIRECT", std::to_string(direct)},
-                                            {"KILN_HDR", hdr_ ? "1" : "0"}}});
+                                            {"KILN_HDR", hdr_ ? "1" : "0"},
+                                            {"KILN_GAMMA_FIT", gammaFit_.usable() ? "1" : "0"}}});
         };
         // keep: the recomputed tiles write the kept light (1), the others read it (2).
         GLuint program = variant(false, keep ? 1 : 0, keep);
@@ -223,6 +228,7 @@ private:
         glUniform1f(glGetUniformLocation(program, "u_exposure"), ctx.getFloat("exposure"));
         glUniform1f(glGetUniformLocation(program, "u_ambient"), ctx.getFloat("ambient"));
         glUniform1f(glGetUniformLocation(program, "u_gamma"), ctx.getFloat("gamma"));
+        glUniform4fv(glGetUniformLocation(program, "u_gammaFit"), 1, gammaFit_.c.data());
         glUniform1i(glGetUniformLocation(program, "u_tonemap"), tonemap == "aces" ? 0 : tonemap == "reinhard" ? 1 : 2);
         glUniform1f(glGetUniformLocation(program, "u_shadowBias"), ctx.getFloat("shadow_bias"));
         glUniform1f(glGetUniformLocation(program, "u_indirectStrength"), ctx.getFloat("indirect_strength"));
@@ -460,6 +466,8 @@ private:
 
     kiln::gl::SamplerHandle compareSampler_;
     bool hdr_ = true;  // this run writes `hdr` (something reads it)
+    float fittedGamma_ = -1.0f;  // what gammaFit_ is for
+    kiln::GammaFit gammaFit_;
 
     // keep_direct (the pass's own objects: a reload starts over).
     // tile_lists.comp's buffer: two draw commands, the count of moved tiles at [8], the lists.

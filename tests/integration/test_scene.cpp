@@ -117,6 +117,44 @@ TEST_CASE("composite writes `hdr` only while something reads it, and in full as 
     CHECK(std::equal(shownRead.pixels.begin(), shownRead.pixels.end(), shownUnread.pixels.begin()));
 }
 
+TEST_CASE("composite's display gamma by its polynomial rounds as pow does, within one 8-bit step", "[scene][gl]") {
+    // The G-buffer and composite alone (no bloom): composite.color is
+    // (ACES(hdr × exposure))^(1/2.2) in 8 bits, here computed with std::pow from the hdr
+    // read back. The shader's polynomial (kiln/gamma_fit.hpp) is within 6e-4 of pow, a
+    // sixth of a step: a value may round the other way only within that of a boundary.
+    Rig rig;
+    std::string error;
+    REQUIRE(rig.app.runtime().loadPipelineText(R"({"output": "composite.color", "passes": [
+        {"id": "gbuffer", "module": "gbuffer"},
+        {"id": "shadow", "module": "shadow"},
+        {"id": "composite", "module": "composite", "params": {"exposure": 1.3},
+         "inputs": {"albedo": "gbuffer.albedo", "normal": "gbuffer.normal", "depth": "gbuffer.depth",
+                    "emissive": "gbuffer.emissive", "shadow_map": "shadow.depth"}}]})",
+                                               "gamma.json", error));
+    rig.app.frame();
+    rig.app.settle();
+    const FloatImage hdr = test::readOutput(rig.app, "composite", "hdr");
+    const FloatImage color = test::readOutput(rig.app, "composite", "color");
+    REQUIRE(hdr.pixels.size() == color.pixels.size());
+    auto aces = [](double x) { return std::clamp(x * (2.51 * x + 0.03) / (x * (2.43 * x + 0.59) + 0.14), 0.0, 1.0); };
+    int worst = 0, off = 0, values = 0, midtones = 0;
+    for (int y = 0; y < hdr.height; ++y)
+        for (int x = 0; x < hdr.width; ++x)
+            for (int c = 0; c < 3; ++c) {
+                const double shown = aces(std::max(double(hdr.at(x, y)[c]), 0.0) * 1.3);
+                const int expected = int(std::lround(255.0 * std::pow(shown, 1.0 / 2.2)));
+                const int got = int(std::lround(255.0 * color.at(x, y)[c]));
+                worst = std::max(worst, std::abs(got - expected));
+                off += got != expected;
+                ++values;
+                midtones += expected > 20 && expected < 235;
+            }
+    INFO(off << " of " << values << " values a step off");
+    CHECK(midtones > values / 2);  // the test sees the curve, not black and white
+    CHECK(worst <= 1);
+    CHECK(off < values / 20);
+}
+
 TEST_CASE("a floor point in a tumbler's shadow is darker than its lit neighbour", "[scene][gl]") {
     Rig rig(oneTumblerScene());
     rig.app.frame();
