@@ -45,7 +45,7 @@ PixelTrace tracePixel(const run::Runtime& runtime, const glm::mat4& invViewProj,
     const std::vector<run::NamedTexture> textures = runtime.textures();
     findWorld(textures, invViewProj, trace);
     for (const run::NamedTexture& t : textures) {
-        if (!t.ref.bound || t.ref.id == 0 || !t.read) continue;  // an unread output holds nothing of this frame
+        if (!t.ref.bound || t.ref.id == 0 || t.stale) continue;  // left unwritten: nothing of this frame
         TraceRow row{t.pass, t.name, t.internal, t.ref.target == GL_TEXTURE_3D};
         if (!row.volume) {
             row.texel = {texelOf(trace.uv, t.ref.width, t.ref.height), 0};

@@ -522,7 +522,8 @@ std::vector<NamedTexture> Runtime::textures() const {
             if (planned && !t.internal && !readEverything)
                 for (size_t k = 0; k < planned->decl.outputs.size() && k < planned->outputRead.size(); ++k)
                     if (planned->decl.outputs[k].name == name) read = planned->outputRead[k];
-            out.push_back({s.id, name, t.internal, t.ref, t.decl.depthNear, t.decl.depthFar, t.decl.size.tiles, read});
+            out.push_back({s.id, name, t.internal, t.ref, t.decl.depthNear, t.decl.depthFar, t.decl.size.tiles, read,
+                           !read && t.decl.onlyWhenRead});
         }
     }
     return out;

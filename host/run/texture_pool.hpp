@@ -71,7 +71,8 @@ struct NamedTexture {
     TextureRef ref;
     float depthNear = 0.0f, depthFar = 0.0f;  // TextureDecl's: how to linearise a depth texture
     int tiles = 1;                             // blocks side by side along x (SizeRule::tiles)
-    bool read = true;  // false: an output nothing reads, which its pass may leave unwritten (PassContext::isRead)
+    bool read = true;    // false: an output nothing reads this frame (PassContext::isRead)
+    bool stale = false;  // unread, and declared onlyWhenRead: not written this frame
 };
 
 // Writes `image`, read back from a texture of `internalFormat`, as BASE.png (clamped to

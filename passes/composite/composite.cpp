@@ -49,7 +49,8 @@ public:
             .input({.name = "bloom", .required = false, .fallback = Fallback::Black})
             .output({.name = "color", .format = Format::RGBA8, .doc = "tonemapped, gamma-encoded final image"})
             .output({.name = "hdr", .format = Format::RGBA16F,
-                     .doc = "linear radiance before bloom, exposure and tonemapping; written only when read"})
+                     .doc = "linear radiance before bloom, exposure and tonemapping; written only when read",
+                     .onlyWhenRead = true})
             .internal({.name = "direct", .format = Format::RGBA16F,
                        .doc = "keep_direct: the lamp's light on each pixel before the fire dims it, kept between runs"})
             .param(floatParam("exposure", 1.0f, 0.01, 16.0, "scales radiance before tonemapping"))

@@ -120,6 +120,9 @@ struct TextureDecl {  // an output (bindable by later passes) or an internal tex
     // viewer can show linear distance (both 0: orthographic or unknown, shown as stored).
     float depthNear = 0.0f, depthFar = 0.0f;
     ProducedWhen producedWhen;  // outputs only
+    // Outputs only: the pass leaves it unwritten while nothing reads it
+    // (PassContext::isRead), so what it holds then is stale; the debug view says so.
+    bool onlyWhenRead = false;
 };
 
 enum class ParamType : uint8_t { Bool, Int, Float, Enum, Color };

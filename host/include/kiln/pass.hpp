@@ -109,7 +109,8 @@
 //   pass binds it, it is not the graph output, and neither the debug view, a dump nor a
 //   tool asked for it (the host's requested textures). A pass may leave such an output
 //   unwritten (composite's `hdr`, which only the error metrics read); what it holds is
-//   then undefined. When something starts reading it, the pass runs again in full.
+//   then undefined. Declare it `.onlyWhenRead = true`, so the debug view knows. When
+//   something starts reading it, the pass runs again in full.
 //
 // EXECUTING
 //   ctx.input/output/internal("name") give a TextureRef (GL name + shape); asking for
@@ -224,8 +225,8 @@ namespace kiln {
 // between passes; 7: GpuFrame::boxWalls; 8: PassContext::keepRunning; 9:
 // SizeRule::capSource and Lod::Medium; 10: ProgramBuild::portability; 11:
 // FrameInfo::redraw; 12: TextureRef::setup; 13: Lod::Fine, and Lod::High's tumblers by
-// their size on screen; 14: PassContext::isRead), so a module built for other terms is
-// refused by name, not run.
+// their size on screen; 14: PassContext::isRead and TextureDecl::onlyWhenRead), so a
+// module built for other terms is refused by name, not run.
 inline constexpr uint32_t kPassAbiVersion = 14;
 
 struct TextureRef {
