@@ -268,7 +268,8 @@ void panelTextures(WindowState& state) {
         const std::string name = t.pass + "." + t.name;
         if (!filter.PassFilter(name.c_str())) continue;
         const std::string label = name + (t.internal ? " (internal)" : "") +
-                                  (t.stale ? " (unread: written once shown)" : t.read ? "" : " (unread)") + "  " + std::to_string(t.ref.width) + "x" +
+                                  (t.stale ? " (unread: written once shown)" : t.read ? "" : " (unread)") + "  " +
+                                  std::to_string(t.ref.width) + "x" +
                                   std::to_string(t.ref.height) +
                                   (t.ref.target == GL_TEXTURE_3D ? "x" + std::to_string(t.ref.depth) : "") + " " +
                                   gl::formatName(t.ref.format);

@@ -708,8 +708,7 @@ private:
     // Output `name` of pass j is read (an internal texture's name: nothing to mark).
     void markRead(int j, const std::string& name) {
         PlannedPass& pp = plan_.passes[static_cast<size_t>(j)];
-        for (size_t k = 0; k < pp.decl.outputs.size(); ++k)
-            if (pp.decl.outputs[k].name == name) pp.outputRead[k] = true;
+        if (const int k = pp.outputIndex(name); k >= 0) pp.outputRead[static_cast<size_t>(k)] = true;
     }
 
     // Stage 4: signatures. Producers are named by id, so a change upstream does not

@@ -90,9 +90,19 @@ const Binding* PlannedPass::binding(std::string_view slot) const {
 }
 
 const TextureDecl* PlannedPass::output(std::string_view name) const {
-    for (const TextureDecl& t : decl.outputs)
-        if (t.name == name) return &t;
-    return nullptr;
+    const int k = outputIndex(name);
+    return k < 0 ? nullptr : &decl.outputs[size_t(k)];
+}
+
+int PlannedPass::outputIndex(std::string_view name) const {
+    for (size_t k = 0; k < decl.outputs.size(); ++k)
+        if (decl.outputs[k].name == name) return int(k);
+    return -1;
+}
+
+bool PlannedPass::outputIsRead(std::string_view name) const {
+    const int k = outputIndex(name);
+    return k >= 0 && size_t(k) < outputRead.size() && outputRead[size_t(k)];
 }
 
 const TextureDecl* PlannedPass::texture(std::string_view name) const {

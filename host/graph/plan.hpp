@@ -78,6 +78,8 @@ struct PlannedPass {
     bool runs() const { return state == PassState::Run; }
     const Binding* binding(std::string_view slot) const;
     const TextureDecl* output(std::string_view name) const;
+    int outputIndex(std::string_view name) const;    // into decl.outputs; -1: no such output
+    bool outputIsRead(std::string_view name) const;  // outputRead's entry; false: no such output
     const TextureDecl* texture(std::string_view name) const;  // output or internal
 };
 

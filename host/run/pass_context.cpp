@@ -35,11 +35,11 @@ bool HostPassContext::isBound(std::string_view name) const {
 }
 
 bool HostPassContext::isRead(std::string_view name) const {
-    for (size_t k = 0; k < planned_.decl.outputs.size(); ++k)
-        if (planned_.decl.outputs[k].name == name)
-            return shared_.readEverything || (k < planned_.outputRead.size() && planned_.outputRead[k]);
-    missing("output", name);
-    return true;
+    if (planned_.outputIndex(name) < 0) {
+        missing("output", name);
+        return true;
+    }
+    return shared_.readEverything || planned_.outputIsRead(name);
 }
 
 const ParamValue& HostPassContext::param(std::string_view name) const {

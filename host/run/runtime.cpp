@@ -518,10 +518,7 @@ std::vector<NamedTexture> Runtime::textures() const {
         const PassSlot& s = *slots_[i];
         const graph::PlannedPass* planned = plan_ && i < plan_->passes.size() ? &plan_->passes[i] : nullptr;
         for (auto& [name, t] : s.textures) {
-            bool read = true;
-            if (planned && !t.internal && !readEverything)
-                for (size_t k = 0; k < planned->decl.outputs.size() && k < planned->outputRead.size(); ++k)
-                    if (planned->decl.outputs[k].name == name) read = planned->outputRead[k];
+            const bool read = !planned || t.internal || readEverything || planned->outputIsRead(name);
             out.push_back({s.id, name, t.internal, t.ref, t.decl.depthNear, t.decl.depthFar, t.decl.size.tiles, read,
                            !read && t.decl.onlyWhenRead});
         }

@@ -178,7 +178,7 @@ public:
             if (!program || (nearField && !nearProgram)) return;
         }
         cacheKey_.reset();
-        if (!(hdr_ ? ctx.framebuffer({"color", "hdr"}) : ctx.framebuffer({"color"}))) return;
+        if (!targets(ctx, false)) return;
         // Where only bodies moved, only what they change (kiln/pass.hpp).
         kiln::forEachRedrawRect(ctx, color.width, color.height, 0, [&] {
             bindInputs(ctx, program);
@@ -212,6 +212,13 @@ private:
         const int x0 = std::max(a.x, b.x), x1 = std::min(a.x + a.width, b.x + b.width);
         const int y0 = std::max(a.y, b.y), y1 = std::min(a.y + a.height, b.y + b.height);
         return {x0, y0, std::max(0, x1 - x0), std::max(0, y1 - y0)};
+    }
+
+    // The framebuffer of `color`, `hdr` when something reads it, and with `direct` the
+    // kept light (composite.frag's outputs in that order: KILN_HDR, KILN_DIRECT 1).
+    GLuint targets(kiln::PassContext& ctx, bool direct) const {
+        if (direct) return hdr_ ? ctx.framebuffer({"color", "hdr", "direct"}) : ctx.framebuffer({"color", "direct"});
+        return hdr_ ? ctx.framebuffer({"color", "hdr"}) : ctx.framebuffer({"color"});
     }
 
     void bindInputs(kiln::PassContext& ctx, GLuint program) const {
@@ -404,8 +411,7 @@ private:
         };
         // The moved tiles, whole (the kept light must be right everywhere, whatever
         // the frame asks to redraw), and the near field again over its rectangle.
-        if (!(hdr_ ? ctx.framebuffer({"color", "hdr", "direct"}) : ctx.framebuffer({"color", "direct"})))
-            return Kept::Failed;
+        if (!targets(ctx, true)) return Kept::Failed;
         drawList(program, true);
         if (nearProgram && !nearRect.empty()) {
             glEnable(GL_SCISSOR_TEST);
@@ -415,7 +421,7 @@ private:
         }
         // The rest from the kept light (where only bodies moved, within the rectangles
         // the frame redraws: kiln/pass.hpp).
-        if (!(hdr_ ? ctx.framebuffer({"color", "hdr"}) : ctx.framebuffer({"color"}))) return Kept::Failed;
+        if (!targets(ctx, false)) return Kept::Failed;
         kiln::forEachRedrawRect(ctx, color.width, color.height, 0, [&] { drawList(cachedProgram, false); });
         glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
         glBindVertexArray(0);

@@ -47,10 +47,9 @@
 //      it overlaps, resolved into `fire` (the optical depth across each voxel, with mips);
 //      then `lamp_transmittance`, the fraction of the lamp seen past it and the fireballs
 //      on a coarser grid (transmittance_resolution; voxelize/fire_transmittance.comp,
-//      common/fire.glsl): the
-//      fire rising round the dome hides part of the lamp. The resolve takes the lamp's
-//      part of each voxel's light (summed apart from what it emits) through it;
-//      cone_trace takes the pixels' for composite.
+//      common/fire.glsl): the fire rising round the dome hides part of the lamp. The
+//      resolve takes the lamp's part of each voxel's light (summed apart from what it
+//      emits) through it; cone_trace takes the pixels' for composite.
 //   4. A compute pass (4³ groups) resolves sum/count into `radiance`: rgb = the mean
 //      outgoing radiance, a = occupancy (1 where any fragment landed, else 0). The
 //      colour is premultiplied by the occupancy (empty voxels are 0,0,0,0), which is

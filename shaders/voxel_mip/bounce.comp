@@ -136,7 +136,9 @@ void main() {
 #if KILN_BOUNCE_STEP != 2
     vec3 gathered = gatherBlock(block);
 #endif
+#if KILN_BOUNCE_STEP == 2 && KILN_GATHER_LIST
     bool surface = false;
+#endif
     for (int i = 0; i < kBlock * kBlock * kBlock; ++i) {
         ivec3 v = voxelOf(block, i);
 #if KILN_BOUNCE_STEP == 0
@@ -147,7 +149,9 @@ void main() {
 #else
         // The last frame's gather (feedback), reflected: this frame's level 0.
         imageStore(u_bounced, v, reflecting(v, texelFetch(u_gathered, v, 0).rgb));
+#if KILN_GATHER_LIST
         surface = surface || reflects(texelFetch(u_emitted, v, 0), texelFetch(u_albedo, v, 0).rgb);
+#endif
 #endif
     }
 #if KILN_BOUNCE_STEP == 2 && KILN_GATHER_LIST
