@@ -312,7 +312,9 @@ try:
     sh("xdotool", "mousemove", "--window", WINDOW, str(x), str(y), "mousedown", "1")
     for step in range(1, 6):
         sh("xdotool", "mousemove", "--window", WINDOW, str(int(x - step * (x - (ix + iw // 4)) / 5)), str(y))
-        frames_later(1)
+        # Two frames: the one in progress may have polled its input before the move (one
+        # was not enough under CI's load: the mouseup then ended the drag a step short).
+        frames_later(2)
     sh("xdotool", "mouseup", "1")
     wait_for(lambda p: abs(p["compare"]["split"] - 0.25) < 0.03, "the line at a quarter")
     frames_later()
