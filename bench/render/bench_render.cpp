@@ -2,10 +2,11 @@
 // headless. A command, not a test: it prints a table and writes CSV.
 //
 //   kiln-bench-render [--pipeline FILE]... [--scene FILE] [--size WxH] [--frames N]
-//                     [--repeats R] [--settle SECONDS] [--set PASS.PARAM=JSON]...
-//                     [--sweep PASS.PARAM=V1,V2,...] [--grow fireballs|marbles=N1,N2,...]
+//                     [--repeats R] [--settle SECONDS] [--steps-per-frame N] [--set PASS.PARAM=JSON]...
+//                     [--sweep PASS.PARAM=V1,V2,...]... | [--grow fireballs|marbles=N1,N2,...]
 //                     [--out DIR]
 //
+// Each --sweep varies one parameter, the others at the file's (and --set's) values.
 // Every pass runs every frame (skipping off) so each frame measures the full cost; the
 // scene moves (the simulation steps every frame). The first 3 frames (shader
 // compilation, first-touch allocation) are discarded. GPU times come from GL timestamp
@@ -58,7 +59,8 @@ struct Config {
 struct Args {
     std::vector<std::string> pipelines;
     std::vector<Override> sets;
-    std::string sweep, scene, growKind;
+    std::vector<std::string> sweeps;  // each swept on its own, the others at the file's values
+    std::string scene, growKind;
     std::vector<int> growCounts;
     double settle = 1.5;
     int stepsPerFrame = 8;  // physics steps (1/240 s) a frame: 8 is the scene in real time at 30 fps
@@ -87,7 +89,7 @@ Args parseArgs(int argc, char** argv) {
         } else if (a == "--frames") args.frames = std::max(1, std::atoi(next().c_str()));
         else if (a == "--repeats") args.repeats = std::max(1, std::atoi(next().c_str()));
         else if (a == "--out") args.outDir = next();
-        else if (a == "--sweep") args.sweep = next();
+        else if (a == "--sweep") args.sweeps.push_back(next());
         else if (a == "--scene") args.scene = next();
         else if (a == "--settle") {
             args.settle = std::atof(next().c_str());
@@ -119,13 +121,17 @@ Args parseArgs(int argc, char** argv) {
             std::printf("usage: kiln-bench-render [--pipeline FILE]... [--scene FILE] [--size WxH] [--frames N]\n"
                         "                         [--repeats R] [--settle SECONDS] [--steps-per-frame N]\n"
                         "                         [--set PASS.PARAM=JSON]...\n"
-                        "                         [--sweep PASS.PARAM=V1,V2,...] [--grow fireballs|marbles=N1,N2,...]\n"
+                        "                         [--sweep PASS.PARAM=V1,V2,...]... | [--grow fireballs|marbles=N1,N2,...]\n"
                         "                         [--out DIR]\n");
             std::exit(0);
         } else {
             usageError("unknown argument \"" + a + "\"");
         }
     }
+    // A grown scene is measured at the pipeline's settings (and --set's): a sweep beside
+    // it would be ignored, so it is refused.
+    if (!args.sweeps.empty() && !args.growKind.empty())
+        usageError("--sweep with --grow: grow one setting at a time (--set PASS.PARAM=V), or sweep without --grow");
     if (args.pipelines.empty()) args.pipelines.push_back((app::defaultDataRoot() / "pipelines/default.json").string());
     return args;
 }
@@ -178,19 +184,21 @@ std::vector<Config> configsOf(const Args& args) {
                                    grownScene(base, args.growKind, n, args.outDir), n});
             continue;
         }
-        if (args.sweep.empty()) {
+        if (args.sweeps.empty()) {
             configs.push_back({p, args.sets, name, args.scene});
             continue;
         }
-        Override base;
-        std::string error;
-        if (!parseOverride(args.sweep, base, error)) usageError("--sweep " + error);
-        std::stringstream values(base.json);
-        std::string v;
-        while (std::getline(values, v, ',')) {
-            Config c{p, args.sets, name + " " + base.pass + "." + base.param + "=" + v, args.scene};
-            c.overrides.push_back({base.pass, base.param, v});
-            configs.push_back(c);
+        for (const std::string& sweep : args.sweeps) {
+            Override base;
+            std::string error;
+            if (!parseOverride(sweep, base, error)) usageError("--sweep " + error);
+            std::stringstream values(base.json);
+            std::string v;
+            while (std::getline(values, v, ',')) {
+                Config c{p, args.sets, name + " " + base.pass + "." + base.param + "=" + v, args.scene};
+                c.overrides.push_back({base.pass, base.param, v});
+                configs.push_back(c);
+            }
         }
     }
     return configs;

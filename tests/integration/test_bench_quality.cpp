@@ -186,7 +186,8 @@ TEST_CASE("kiln-bench-render --grow: one growth row per count, the first the bas
     }
     CHECK(passRows >= 2 * 5);  // two configurations, every pass of the default
 
-    for (const char* bad : {"--grow comets=1", "--grow fireballs=x", "--grow fireballs=-1", "--settle 99"}) {
+    for (const char* bad : {"--grow comets=1", "--grow fireballs=x", "--grow fireballs=-1", "--settle 99",
+                            "--sweep shadow.size=256,512 --grow fireballs=1"}) {
         Run b = runProgram(KILN_BENCH_RENDER, std::string(bad) + " --out " + out, 60);
         INFO(bad << ": " << b.err);
         CHECK(b.exitCode == 2);
