@@ -67,8 +67,11 @@ public:
         // blur reads `ping` `taps` texels up and down, which read `bright` `taps` left and
         // right, so each stage covers the next one's rectangles grown by `taps` (and the
         // flag sees every texel the blur reads); `bloom` one texel spare for composite's
-        // filtered read.
+        // filtered read. The bright-pass stores only the bright texels (bloom/bright.comp),
+        // so each rectangle is cleared first.
+        const float black[4] = {0.0f, 0.0f, 0.0f, 1.0f};
         for (const kiln::PixelRect& r : kiln::redrawRects(ctx, bright.width, bright.height, 2 * taps + 1)) {
+            glClearTexSubImage(bright.id, 0, r.x, r.y, 0, r.width, r.height, 1, GL_RGBA, GL_FLOAT, black);
             glUniform2i(glGetUniformLocation(brightPass, "u_origin"), r.x, r.y);
             glDispatchCompute(GLuint((r.width + 7) / 8), GLuint((r.height + 7) / 8), 1);
         }
@@ -87,7 +90,6 @@ public:
         for (int i = 0; i <= taps; ++i) weights[i] /= total;
         glUniform1fv(glGetUniformLocation(blur, "u_weights"), taps + 1, weights);
         // Black where nothing is drawn (blur.vert collapses the triangle when nothing is bright).
-        const float black[4] = {0.0f, 0.0f, 0.0f, 1.0f};
         if (!ctx.framebuffer({"ping"})) return;
         glUniform2f(glGetUniformLocation(blur, "u_direction"), 1.0f, 0.0f);
         glUniform1f(glGetUniformLocation(blur, "u_gain"), 1.0f);
