@@ -5,11 +5,12 @@
 // the same fixed-point sums and count as voxelize.frag, so resolve.comp averages it with
 // the surfaces around it. A sphere smaller than a voxel lands in the voxels its bounding
 // box overlaps (at most 2×2×2).
-//   fireballs  emission (scaled as the rasterized ones: fireball_emission, and with
-//              fireball_flux to the sphere's flux) plus the lamp's light on the surface
-//              point facing the voxel's centre, lit as voxelize.frag lights a fragment
-//              (surface.glsl): the first u_litCount spheres.
-//   particles  emitters with no albedo: their emission, no surface (albedo, normal); the rest.
+//   KILN_SPLAT_LIT 1, fireballs: emission (scaled as the rasterized ones:
+//              fireball_emission, and with fireball_flux to the sphere's flux) plus the
+//              lamp's light on the surface point facing the voxel's centre, lit as
+//              voxelize.frag lights a fragment (surface.glsl).
+//   KILN_SPLAT_LIT 0, particles: emitters with no albedo: their emission, no surface
+//              (albedo, normal).
 // The spheres are the instances [u_first, u_first + u_sphereCount) of the scene's
 // instance buffer. Cost: a few atomics per voxel of the shell, where rasterizing the mesh cost a
 // geometry-shader invocation per triangle.
@@ -20,11 +21,16 @@
 #include "sums.glsl"
 #include "surface.glsl"
 
+// The fireballs are few and each costs many voxels' lighting: eight to a group spreads
+// them over llvmpipe's threads, where 64 to a group put all of them on one.
+#if KILN_SPLAT_LIT
+layout(local_size_x = 8) in;
+#else
 layout(local_size_x = 64) in;
+#endif
 
 uniform uint u_first;
 uniform uint u_sphereCount;
-uniform uint u_litCount;
 uniform float u_fireballEmission;  // voxelize's fireball_emission, as the rasterized fireballs take it
 uniform bool u_sphereFlux;         // fireball_flux: each fireball's blob at its sphere's flux
 
@@ -36,8 +42,11 @@ void main() {
     float voxel = 2.0 / float(u_res);
     ivec3 lo = max(ivec3(floor(((centre - radius) * 0.5 + 0.5) * float(u_res))), ivec3(0));
     ivec3 hi = min(ivec3(floor(((centre + radius) * 0.5 + 0.5) * float(u_res))), ivec3(u_res - 1));
+#if KILN_SPLAT_LIT
+    uvec3 emitted = toFixedRadiance(inst.emissive.rgb * u_fireballEmission * (u_sphereFlux ? sphereFluxScale(radius) : 1.0));
+#else
     uvec3 emitted = toFixedRadiance(inst.emissive.rgb);
-    vec3 fireballEmission = inst.emissive.rgb * u_fireballEmission * (u_sphereFlux ? sphereFluxScale(radius) : 1.0);
+#endif
     for (int z = lo.z; z <= hi.z; ++z)
         for (int y = lo.y; y <= hi.y; ++y)
             for (int x = lo.x; x <= hi.x; ++x) {
@@ -46,13 +55,13 @@ void main() {
                 float nearest = distance(clamp(centre, cubeLo, cubeHi), centre);
                 float farthest = length(max(abs(cubeLo - centre), abs(cubeHi - centre)));
                 if (nearest > radius || farthest < radius) continue;
-                if (gl_GlobalInvocationID.x < u_litCount) {
-                    vec3 towards = 0.5 * (cubeLo + cubeHi) - centre;
-                    vec3 n = dot(towards, towards) > 1e-12 ? normalize(towards) : vec3(0.0, 1.0, 0.0);
-                    uvec3 lit = toFixedRadiance(lampReflected(inst.albedo.rgb, centre + n * radius, n));
-                    addSurfaceToVoxel(ivec3(x, y, z), lit, toFixedRadiance(fireballEmission), inst.albedo.rgb, n);
-                } else {
-                    addToVoxel(ivec3(x, y, z), emitted);
-                }
+#if KILN_SPLAT_LIT
+                vec3 towards = 0.5 * (cubeLo + cubeHi) - centre;
+                vec3 n = dot(towards, towards) > 1e-12 ? normalize(towards) : vec3(0.0, 1.0, 0.0);
+                uvec3 lit = toFixedRadiance(lampReflected(inst.albedo.rgb, centre + n * radius, n));
+                addSurfaceToVoxel(ivec3(x, y, z), lit, emitted, inst.albedo.rgb, n);
+#else
+                addToVoxel(ivec3(x, y, z), emitted);
+#endif
             }
 }
