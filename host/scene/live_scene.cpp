@@ -1,5 +1,7 @@
 #include "scene/live_scene.hpp"
 
+#include <algorithm>
+
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/type_ptr.hpp>
 
@@ -82,18 +84,28 @@ void LiveScene::writeTo(SceneRenderer& renderer, int highlighted) {
         // voxelized or path-traced. Left in, it hid the lamp a second time behind the
         // fireball's own disc (voxelize's fire cover) and cost the cover's test 3 ms at 50
         // fireballs on llvmpipe where this loop costs the CPU about 0.1 (0.36 with a square
-        // root a pair: |p - c| + r <= R is |p - c|² <= (R - r)² with R >= r).
+        // root a pair: |p - c| + r <= R is |p - c|² <= (R - r)² with R >= r). Only the
+        // fireballs within the largest radius of the particle along x can hide it: sorted
+        // by x, those are a range (4 000 particles against 50 fireballs, every pair tested,
+        // took 0.3 ms a frame).
         std::vector<glm::dvec4> fireballs;  // xyz centre, w radius
+        double largest = 0.0;
         for (const auto& b : sim_.balls())
-            if (b.kind == sim::BallKind::Fireball) fireballs.emplace_back(b.position, b.radius);
+            if (b.kind == sim::BallKind::Fireball) {
+                fireballs.emplace_back(b.position, b.radius);
+                largest = std::max(largest, b.radius);
+            }
+        std::sort(fireballs.begin(), fireballs.end(), [](const glm::dvec4& a, const glm::dvec4& b) { return a.x < b.x; });
         std::vector<ParticleInstance> particles;
         particles.reserve(sim_.particles().size());
         for (const auto& p : sim_.particles()) {
             const double r = p.radius();
             bool hidden = false;
-            for (const glm::dvec4& f : fireballs) {
-                const glm::dvec3 d = p.position - glm::dvec3(f);
-                hidden |= f.w >= r && glm::dot(d, d) <= (f.w - r) * (f.w - r);
+            auto f = std::lower_bound(fireballs.begin(), fireballs.end(), p.position.x - largest,
+                                      [](const glm::dvec4& b, double x) { return b.x < x; });
+            for (; !hidden && f != fireballs.end() && f->x <= p.position.x + largest; ++f) {
+                const glm::dvec3 d = p.position - glm::dvec3(*f);
+                hidden = f->w >= r && glm::dot(d, d) <= (f->w - r) * (f->w - r);
             }
             if (!hidden) particles.push_back({glm::vec3(p.position), float(r), glm::vec3(p.emission())});
         }
