@@ -1,12 +1,14 @@
 // kiln-bench-skip and kiln-bench-overhead — what skipping saves and what the graph
 // costs, measured in one run each (commands, not tests: they print a table and write CSV).
 //
-//   kiln-bench-skip     [--size WxH] [--frames N] [--repeats R] [--out DIR]
-//   kiln-bench-overhead [--size WxH] [--frames N] [--repeats R] [--out DIR]
+//   kiln-bench-skip     [--size WxH] [--frames N] [--repeats R] [--steps-per-frame N] [--out DIR]
+//   kiln-bench-overhead [--size WxH] [--frames N] [--repeats R] [--steps-per-frame N] [--out DIR]
 //
 // Each situation is measured in R rounds that visit every situation in turn, each round
 // starting one later (a slow minute of a shared machine, or a slow slot, lands on all of
-// them); figures are medians over rounds.
+// them); figures are medians over rounds. A frame moves the scene --steps-per-frame
+// physics steps of 1/240 s (default 8: real time at 30 fps, as kiln-bench-render), since
+// how far things move between frames is what the passes that redo only what moved pay for.
 //
 // skip: the default pipeline and scene in eleven situations, one after the other in one
 // process: moving; paused (nothing changes: every pass may skip, once voxel_mip's
@@ -72,7 +74,7 @@ GuardCost measureGuard(int rounds) {
 }
 
 struct Args {
-    int width = 256, height = 256, frames = 30, repeats = 3;
+    int width = 256, height = 256, frames = 30, repeats = 3, stepsPerFrame = 8;
     std::string outDir = "bench-out";
 };
 
@@ -85,8 +87,15 @@ Args parseArgs(int argc, char** argv, const char* name) {
         else if (arg == "--frames" && hasValue) a.frames = std::max(3, std::atoi(argv[++i]));
         else if (arg == "--repeats" && hasValue) a.repeats = std::max(1, std::atoi(argv[++i]));
         else if (arg == "--out" && hasValue) a.outDir = argv[++i];
+        else if (arg == "--steps-per-frame" && hasValue) {
+            a.stepsPerFrame = std::atoi(argv[++i]);
+            if (a.stepsPerFrame < 1 || a.stepsPerFrame > 240) {
+                std::fprintf(stderr, "%s: error: --steps-per-frame: expected 1 to 240\n", name);
+                std::exit(2);
+            }
+        }
         else {
-            std::fprintf(stderr, "%s: error: unknown or incomplete option \"%s\"\nusage: %s [--size WxH] [--frames N] [--repeats R] [--out DIR]\n",
+            std::fprintf(stderr, "%s: error: unknown or incomplete option \"%s\"\nusage: %s [--size WxH] [--frames N] [--repeats R] [--steps-per-frame N] [--out DIR]\n",
                          name, arg.c_str(), name);
             std::exit(2);
         }
@@ -126,7 +135,7 @@ struct Outcome {
 
 // `frames` frames of one situation after its warm-up frames, with skipping on as a user
 // runs it.
-Outcome runSituation(app::App& app, const Situation& s, int frames) {
+Outcome runSituation(app::App& app, const Situation& s, int frames, int stepsPerFrame) {
     std::string error;
     if (!app.runtime().loadPipelineText(s.pipelineText, s.label, error) || !app.scene().load(s.sceneFile, std::nullopt, error)) {
         std::fprintf(stderr, "error: %s: %s\n", s.label.c_str(), error.c_str());
@@ -135,7 +144,12 @@ Outcome runSituation(app::App& app, const Situation& s, int frames) {
     app.paused = false;
     app.redrawParts = !s.fullRedraw;
     for (double t = 0.0; t < s.restSeconds; t += app.scene().dt()) app.scene().step();
-    for (int f = 0; f < s.warmFrames; ++f) app.frame();
+    // app.frame() takes the frame's last step; a paused scene takes none.
+    auto frame = [&] {
+        for (int k = 1; k < stepsPerFrame && !app.paused; ++k) app.scene().step();
+        app.frame();
+    };
+    for (int f = 0; f < s.warmFrames; ++f) frame();
     if (s.settled) app.settle();
     app.paused = s.paused;
     app.frame();  // the paused state's first frame still runs what the last step changed
@@ -144,7 +158,7 @@ Outcome runSituation(app::App& app, const Situation& s, int frames) {
     std::vector<double> wall, host, passes;
     for (int f = 0; f < frames; ++f) {
         const auto start = std::chrono::steady_clock::now();
-        app.frame();
+        frame();
         glFinish();
         wall.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
         const auto cost = app.runtime().lastFrameCost();
@@ -204,7 +218,7 @@ std::vector<Outcome> measureRounds(app::App& app, const std::vector<Situation>& 
     for (int r = 0; r < args.repeats; ++r)
         for (size_t k = 0; k < situations.size(); ++k) {
             const size_t i = (k + size_t(r)) % situations.size();
-            rounds[i].push_back(runSituation(app, situations[i], args.frames));
+            rounds[i].push_back(runSituation(app, situations[i], args.frames, args.stepsPerFrame));
         }
     std::vector<Outcome> outcomes;
     for (auto& all : rounds) {
@@ -314,8 +328,9 @@ int main(int argc, char** argv) {
     }
     const std::vector<Outcome> outcomes = measureRounds(app, situations, args);
 
-    std::printf("%s: %s, %dx%d, medians of %d frames each over %d rounds, one process\n\n", name,
-                context->description().c_str(), args.width, args.height, args.frames, args.repeats);
+    std::printf("%s: %s, %dx%d, medians of %d frames each over %d rounds, %d physics steps a frame, one process\n\n",
+                name, context->description().c_str(), args.width, args.height, args.frames, args.repeats,
+                args.stepsPerFrame);
     const std::string csvPath = (fs::path(args.outDir) / (overhead ? "overhead.csv" : "skip.csv")).string();
     std::ofstream csv(csvPath);
     if (overhead) reportOverhead(outcomes, args, csv);
