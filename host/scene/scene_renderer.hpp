@@ -54,10 +54,8 @@ struct ParticleInstance {
 // The sphere mesh for a marble or fireball whose radius spans `radiusPx` pixels on
 // screen: 0 = 32 segments around, 1 = 16, 2 = 10 (the voxelization mesh). A polygon of
 // n segments strays from its circle by r·(1 − cos(π/n)); the thresholds keep that under
-// a pixel up to a 200-px radius (tests/integration/test_scene.cpp): 10 segments stray
-// 0.98 px at 20 px. The far mesh up to 20 px rather than 12 took the G-buffer 9.6 -> 8.6
-// ms at 720² with 50 fireballs (four alternations), 5.35 -> 5.28 with two.
-constexpr float kSphereNearPx = 48.0f, kSphereFarPx = 20.0f;
+// a pixel up to a 200-px radius (tests/integration/test_scene.cpp).
+constexpr float kSphereNearPx = 48.0f, kSphereFarPx = 12.0f;
 inline int sphereLevelFor(float radiusPx) { return radiusPx >= kSphereNearPx ? 0 : radiusPx >= kSphereFarPx ? 1 : 2; }
 inline constexpr int kSphereSegments[3] = {32, 16, 10};
 
