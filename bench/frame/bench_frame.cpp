@@ -95,7 +95,9 @@ Args parseArgs(int argc, char** argv, const char* name) {
             }
         }
         else {
-            std::fprintf(stderr, "%s: error: unknown or incomplete option \"%s\"\nusage: %s [--size WxH] [--frames N] [--repeats R] [--steps-per-frame N] [--out DIR]\n",
+            std::fprintf(stderr,
+                         "%s: error: unknown or incomplete option \"%s\"\n"
+                         "usage: %s [--size WxH] [--frames N] [--repeats R] [--steps-per-frame N] [--out DIR]\n",
                          name, arg.c_str(), name);
             std::exit(2);
         }

@@ -121,7 +121,8 @@ Args parseArgs(int argc, char** argv) {
             std::printf("usage: kiln-bench-render [--pipeline FILE]... [--scene FILE] [--size WxH] [--frames N]\n"
                         "                         [--repeats R] [--settle SECONDS] [--steps-per-frame N]\n"
                         "                         [--set PASS.PARAM=JSON]...\n"
-                        "                         [--sweep PASS.PARAM=V1,V2,...]... | [--grow fireballs|marbles=N1,N2,...]\n"
+                        "                         [--sweep PASS.PARAM=V1,V2,...]...\n"
+                        "                         | [--grow fireballs|marbles=N1,N2,...]\n"
                         "                         [--out DIR]\n");
             std::exit(0);
         } else {

@@ -95,7 +95,8 @@ void LiveScene::writeTo(SceneRenderer& renderer, int highlighted) {
                 fireballs.emplace_back(b.position, b.radius);
                 largest = std::max(largest, b.radius);
             }
-        std::sort(fireballs.begin(), fireballs.end(), [](const glm::dvec4& a, const glm::dvec4& b) { return a.x < b.x; });
+        std::sort(fireballs.begin(), fireballs.end(),
+                  [](const glm::dvec4& a, const glm::dvec4& b) { return a.x < b.x; });
         std::vector<ParticleInstance> particles;
         particles.reserve(sim_.particles().size());
         for (const auto& p : sim_.particles()) {

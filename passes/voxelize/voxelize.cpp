@@ -199,8 +199,9 @@ public:
         kiln::Defines litSpheres = lamp, emitters = lamp;
         litSpheres.push_back({"KILN_SPLAT_LIT", "1"});
         emitters.push_back({"KILN_SPLAT_LIT", "0"});
-        GLuint fireballSplatter = splatFireballs ? ctx.program({.stages = {"voxelize/splat.comp"}, .defines = litSpheres}) : 0;
-        GLuint particleSplatter = splatParticles ? ctx.program({.stages = {"voxelize/splat.comp"}, .defines = emitters}) : 0;
+        const std::vector<std::string> splatStage = {"voxelize/splat.comp"};
+        GLuint fireballSplatter = splatFireballs ? ctx.program({.stages = splatStage, .defines = litSpheres}) : 0;
+        GLuint particleSplatter = splatParticles ? ctx.program({.stages = splatStage, .defines = emitters}) : 0;
         const bool splatTumblers = ctx.getEnum("tumbler_mode") == "splat";
         GLuint tumblerSplatter = splatTumblers ? ctx.program({.stages = {"voxelize/tumblers.comp"}, .defines = lamp}) : 0;
         if (!raster || !resolve || (keepStatic && (!recorder || !staticLighter)) ||

@@ -43,7 +43,8 @@ void main() {
     ivec3 lo = max(ivec3(floor(((centre - radius) * 0.5 + 0.5) * float(u_res))), ivec3(0));
     ivec3 hi = min(ivec3(floor(((centre + radius) * 0.5 + 0.5) * float(u_res))), ivec3(u_res - 1));
 #if KILN_SPLAT_LIT
-    uvec3 emitted = toFixedRadiance(inst.emissive.rgb * u_fireballEmission * (u_sphereFlux ? sphereFluxScale(radius) : 1.0));
+    float flux = u_sphereFlux ? sphereFluxScale(radius) : 1.0;
+    uvec3 emitted = toFixedRadiance(inst.emissive.rgb * u_fireballEmission * flux);
 #else
     uvec3 emitted = toFixedRadiance(inst.emissive.rgb);
 #endif
