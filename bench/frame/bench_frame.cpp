@@ -74,7 +74,7 @@ GuardCost measureGuard(int rounds) {
 }
 
 struct Args {
-    int width = 256, height = 256, frames = 30, repeats = 3, stepsPerFrame = 8;
+    int width = 256, height = 256, frames = 30, repeats = 3, stepsPerFrame = kDefaultStepsPerFrame;
     std::string outDir = "bench-out";
 };
 
@@ -89,8 +89,8 @@ Args parseArgs(int argc, char** argv, const char* name) {
         else if (arg == "--out" && hasValue) a.outDir = argv[++i];
         else if (arg == "--steps-per-frame" && hasValue) {
             a.stepsPerFrame = std::atoi(argv[++i]);
-            if (a.stepsPerFrame < 1 || a.stepsPerFrame > 240) {
-                std::fprintf(stderr, "%s: error: --steps-per-frame: expected 1 to 240\n", name);
+            if (a.stepsPerFrame < 1 || a.stepsPerFrame > kMaxStepsPerFrame) {
+                std::fprintf(stderr, "%s: error: --steps-per-frame: expected 1 to %d\n", name, kMaxStepsPerFrame);
                 std::exit(2);
             }
         }
@@ -146,11 +146,7 @@ Outcome runSituation(app::App& app, const Situation& s, int frames, int stepsPer
     app.paused = false;
     app.redrawParts = !s.fullRedraw;
     for (double t = 0.0; t < s.restSeconds; t += app.scene().dt()) app.scene().step();
-    // app.frame() takes the frame's last step; a paused scene takes none.
-    auto frame = [&] {
-        for (int k = 1; k < stepsPerFrame && !app.paused; ++k) app.scene().step();
-        app.frame();
-    };
+    auto frame = [&] { frameMoving(app, stepsPerFrame); };
     for (int f = 0; f < s.warmFrames; ++f) frame();
     if (s.settled) app.settle();
     app.paused = s.paused;

@@ -63,7 +63,7 @@ struct Args {
     std::string scene, growKind;
     std::vector<int> growCounts;
     double settle = 1.5;
-    int stepsPerFrame = 8;  // physics steps (1/240 s) a frame: 8 is the scene in real time at 30 fps
+    int stepsPerFrame = kDefaultStepsPerFrame;
     int width = 720, height = 720, frames = 20, repeats = 3;
     std::string outDir = "bench-out";
 };
@@ -96,7 +96,8 @@ Args parseArgs(int argc, char** argv) {
             if (!(args.settle >= 0 && args.settle <= 60)) usageError("--settle: expected seconds in [0, 60]");
         } else if (a == "--steps-per-frame") {
             args.stepsPerFrame = std::atoi(next().c_str());
-            if (args.stepsPerFrame < 1 || args.stepsPerFrame > 240) usageError("--steps-per-frame: expected 1 to 240");
+            if (args.stepsPerFrame < 1 || args.stepsPerFrame > kMaxStepsPerFrame)
+                usageError("--steps-per-frame: expected 1 to " + std::to_string(kMaxStepsPerFrame));
         } else if (a == "--grow") {
             const std::string v = next();
             const size_t eq = v.find('=');
@@ -279,13 +280,7 @@ bool measureRound(const Args& args, const Config& config, const std::string& tex
     if (!app.init(o, error) || !app.runtime().loadPipelineText(text, config.pipeline, error)) return false;
     app.runtime().alwaysRun = true;
     while (app.scene().time() + 1e-9 < args.settle) app.scene().step();
-    // Each frame moves the scene --steps-per-frame physics steps (app.frame() takes the
-    // last): how far it moves between frames is what the passes that recompute only
-    // what moved pay for.
-    auto frame = [&] {
-        for (int s = 1; s < args.stepsPerFrame; ++s) app.scene().step();
-        app.frame();
-    };
+    auto frame = [&] { frameMoving(app, args.stepsPerFrame); };
     for (int f = 0; f < 3; ++f) frame();
     glFinish();
     app.runtime().resetTimings();  // only the frames after warm-up count

@@ -1,5 +1,5 @@
 // What the benchmark commands share: PASS.PARAM=VALUE overrides applied to a
-// pipeline's JSON, medians, reading a file.
+// pipeline's JSON, medians, reading a file, a frame of a scene moving in real time.
 #pragma once
 
 #include <algorithm>
@@ -10,7 +10,21 @@
 
 #include <nlohmann/json.hpp>
 
+#include "app/app.hpp"
+
 namespace kiln::bench {
+
+// --steps-per-frame: physics steps of 1/240 s a frame; 8 is the scene in real time at
+// 30 fps, and how far things move between frames is what the passes that redo only what
+// moved pay for.
+inline constexpr int kDefaultStepsPerFrame = 8, kMaxStepsPerFrame = 240;
+
+// One frame `stepsPerFrame` physics steps on (app.frame() takes the last; a paused scene
+// takes none).
+inline void frameMoving(app::App& app, int stepsPerFrame) {
+    for (int k = 1; k < stepsPerFrame && !app.paused; ++k) app.scene().step();
+    app.frame();
+}
 
 struct Override {
     std::string pass, param, json;
