@@ -198,7 +198,9 @@ public:
         // splat.comp's two variants: the fireballs as lit surfaces, the particles as emitters.
         kiln::Defines litSpheres = lamp, emitters = lamp;
         litSpheres.push_back({"KILN_SPLAT_LIT", "1"});
+        litSpheres.push_back({"KILN_SPLAT_GROUP", std::to_string(kFireballGroup)});
         emitters.push_back({"KILN_SPLAT_LIT", "0"});
+        emitters.push_back({"KILN_SPLAT_GROUP", std::to_string(kParticleGroup)});
         const std::vector<std::string> splatStage = {"voxelize/splat.comp"};
         GLuint fireballSplatter = splatFireballs ? ctx.program({.stages = splatStage, .defines = litSpheres}) : 0;
         GLuint particleSplatter = splatParticles ? ctx.program({.stages = splatStage, .defines = emitters}) : 0;
@@ -229,8 +231,8 @@ public:
         // The particles' cover and the transmittance grid from it: the resolve reads the grid.
         if (fireCover) coverFire(ctx, coverer, fireResolve, fireMip, fireLight, res);
         rasterize(ctx, raster, res, !keepStatic, particles && !splatParticles, !splatFireballs, !splatTumblers);
-        if (fireballSplatter) splat(ctx, fireballSplatter, res, kiln::kSceneFireballs);
-        if (particleSplatter) splat(ctx, particleSplatter, res, kiln::kSceneParticles);
+        if (fireballSplatter) splat(ctx, fireballSplatter, kFireballGroup, res, kiln::kSceneFireballs);
+        if (particleSplatter) splat(ctx, particleSplatter, kParticleGroup, res, kiln::kSceneParticles);
         if (tumblerSplatter) splatTumblerShapes(ctx, tumblerSplatter, res);
         resolveSums(ctx, resolve, out, res);
     }
@@ -363,9 +365,10 @@ private:
     // The fireballs or the particles, splatted by `splatter` (splat.comp: lit spheres or
     // emitters). One program with a branch between the two ran the fireballs' lighting for
     // every particle (llvmpipe runs an `if` for every lane): 50 fireballs and their 4 000
-    // particles cost voxelize 1.75 ms at 720², apart 0.3 + 0.7 (eight fireballs to a group).
-    static void splat(kiln::PassContext& ctx, GLuint splatter, int res, kiln::SceneCategory spheres) {
-        const uint32_t groupSize = spheres == kiln::kSceneFireballs ? 8 : 64;  // splat.comp's local size
+    // particles cost voxelize 1.75 ms at 720², apart 0.3 + 0.7. `groupSize`: the
+    // program's KILN_SPLAT_GROUP.
+    static void splat(kiln::PassContext& ctx, GLuint splatter, uint32_t groupSize, int res,
+                      kiln::SceneCategory spheres) {
         const kiln::SceneView& scene = ctx.scene();
         const uint32_t count = scene.count(spheres);
         if (count == 0) return;
@@ -507,6 +510,10 @@ private:
     kiln::gl::FramebufferHandle fbo_;  // attachment-less; a GL cache only (a reload makes a new one)
     int fboSize_ = 0;
     static constexpr int kRasterTile = 64;  // llvmpipe shades a framebuffer in tiles of 64², one thread each
+    // splat.comp's workgroups. The fireballs are few and each costs many voxels' lighting:
+    // eight to a group spreads fifty over llvmpipe's threads (0.3 ms), where 64 put them
+    // all on one (0.5).
+    static constexpr uint32_t kFireballGroup = 8, kParticleGroup = 64;
 };
 
 }  // namespace

@@ -21,13 +21,7 @@
 #include "sums.glsl"
 #include "surface.glsl"
 
-// The fireballs are few and each costs many voxels' lighting: eight to a group spreads
-// them over llvmpipe's threads, where 64 to a group put all of them on one.
-#if KILN_SPLAT_LIT
-layout(local_size_x = 8) in;
-#else
-layout(local_size_x = 64) in;
-#endif
+layout(local_size_x = KILN_SPLAT_GROUP) in;  // voxelize.cpp: as it dispatches
 
 uniform uint u_first;
 uniform uint u_sphereCount;
