@@ -30,8 +30,9 @@ void LiveReload::start(App& app) {
     watcher_ = std::make_unique<FileWatcher>();
     for (auto& root : app.runtime().shaders().roots()) watcher_->watch(root);
     for (auto& dir : app.runtime().loader().dirs()) watcher_->watch(dir);
-    watcher_->watch(canonical(app.runtime().pipelineFile()).parent_path());
-    watcher_->watch(canonical(app.scene().file()).parent_path());
+    // Pipelines and scenes are JSON files; their directories may hold anything.
+    watcher_->watch(canonical(app.runtime().pipelineFile()).parent_path(), FileWatcher::Depth::ThisDirectory, ".json");
+    watcher_->watch(canonical(app.scene().file()).parent_path(), FileWatcher::Depth::ThisDirectory, ".json");
 }
 
 namespace {

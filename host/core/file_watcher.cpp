@@ -54,28 +54,37 @@ bool FileWatcher::isNoise(const std::string& name) {
     return false;
 }
 
-bool FileWatcher::watch(const fs::path& dirIn) {
+bool FileWatcher::watch(const fs::path& dirIn, Depth depth, const std::string& extension) {
     std::error_code ec;
     fs::path dir = fs::weakly_canonical(dirIn, ec);
     if (ec || !fs::is_directory(dir, ec)) return false;
-    roots_.push_back(dir);
-    addDirectory(dir);
+    roots_.push_back({dir, depth, extension});
+    addDirectory(roots_.back());
     return true;
 }
 
-void FileWatcher::addDirectory(const fs::path& dir, bool firstSight) {
+void FileWatcher::addDirectory(const Watched& how, bool firstSight) {
     std::error_code ec;
     if (fd_ >= 0) {
         const uint32_t mask = IN_CLOSE_WRITE | IN_MOVED_TO | IN_CREATE | IN_DELETE | IN_DELETE_SELF | IN_MOVE_SELF;
-        int wd = inotify_add_watch(fd_, dir.c_str(), mask);
-        if (wd >= 0) watches_[wd] = dir;
+        int wd = inotify_add_watch(fd_, how.dir.c_str(), mask);
+        // One inotify watch a directory: watched two ways, it is watched the wider.
+        if (wd >= 0) {
+            auto [it, added] = watches_.try_emplace(wd, how);
+            if (!added) {
+                if (how.depth == Depth::Recursive) it->second.depth = Depth::Recursive;
+                if (how.extension != it->second.extension) it->second.extension.clear();
+            }
+        }
     }
-    for (auto& entry : fs::directory_iterator(dir, ec)) {
+    for (auto& entry : fs::directory_iterator(how.dir, ec)) {
         if (entry.is_directory(ec)) {
-            addDirectory(entry.path(), firstSight);
-        } else if (!firstSight && entry.is_regular_file(ec)) {
+            if (how.depth == Depth::Recursive) addDirectory({entry.path(), how.depth, how.extension}, firstSight);
+        } else if (!how.covers(entry.path()) || !entry.is_regular_file(ec)) {
+            continue;
+        } else if (!firstSight) {
             noteEvent(entry.path());
-        } else if (entry.is_regular_file(ec) && !isNoise(entry.path().filename().string())) {
+        } else if (!isNoise(entry.path().filename().string())) {
             bool ok = false;
             Known k;
             k.hash = hashFile(entry.path(), ok);
@@ -89,7 +98,7 @@ void FileWatcher::addDirectory(const fs::path& dir, bool firstSight) {
 
 bool FileWatcher::isWatched(const fs::path& dir) const {
     for (auto& [wd, watched] : watches_)
-        if (watched == dir) return true;
+        if (watched.dir == dir) return true;
     return false;
 }
 
@@ -100,11 +109,12 @@ void FileWatcher::noteEvent(const fs::path& file) {
 
 void FileWatcher::rescan() {
     // After an overflow (or in polling mode): anything whose identity changed is an event.
-    for (auto& root : roots_) {
+    for (const Watched& root : roots_) {
         std::error_code ec;
-        for (auto it = fs::recursive_directory_iterator(root, ec); it != fs::recursive_directory_iterator(); it.increment(ec)) {
+        for (auto it = fs::recursive_directory_iterator(root.dir, ec); it != fs::recursive_directory_iterator(); it.increment(ec)) {
             if (ec) break;
-            if (!it->is_regular_file(ec) || isNoise(it->path().filename().string())) continue;
+            if (root.depth == Depth::ThisDirectory) it.disable_recursion_pending();
+            if (!root.covers(it->path()) || !it->is_regular_file(ec) || isNoise(it->path().filename().string())) continue;
             auto found = known_.find(it->path());
             const auto mtime = fs::last_write_time(it->path(), ec);
             const auto size = fs::file_size(it->path(), ec);
@@ -123,10 +133,10 @@ std::vector<fs::path> FileWatcher::poll() {
         // checked out again): look for it while it is gone.
         if (Clock::now() - lastRootCheck_ > std::chrono::milliseconds(250)) {
             lastRootCheck_ = Clock::now();
-            for (const fs::path& root : roots_) {
+            for (const Watched& root : roots_) {
                 std::error_code ec;
-                if (isWatched(root) || !fs::is_directory(root, ec)) continue;
-                log::info("file watcher: ", root.string(), " is back; watching it again");
+                if (isWatched(root.dir) || !fs::is_directory(root.dir, ec)) continue;
+                log::info("file watcher: ", root.dir.string(), " is back; watching it again");
                 addDirectory(root, false);
             }
         }
@@ -157,16 +167,16 @@ void FileWatcher::readEvents() {
                 continue;
             }
             if (e->len == 0) continue;
-            const fs::path path = dir->second / e->name;
+            const fs::path path = dir->second.dir / e->name;
             if (e->mask & IN_ISDIR) {
-                if (e->mask & (IN_CREATE | IN_MOVED_TO)) {
-                    addDirectory(path);
+                if ((e->mask & (IN_CREATE | IN_MOVED_TO)) && dir->second.depth == Depth::Recursive) {
+                    addDirectory({path, Depth::Recursive, dir->second.extension});
                     rescan();  // files written before the watch existed
                 }
                 continue;
             }
             // IN_CREATE alone may be a half-written file: wait for CLOSE_WRITE.
-            if (e->mask & (IN_CLOSE_WRITE | IN_MOVED_TO)) noteEvent(path);
+            if ((e->mask & (IN_CLOSE_WRITE | IN_MOVED_TO)) && dir->second.covers(path)) noteEvent(path);
         }
     }
 }

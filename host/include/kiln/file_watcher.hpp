@@ -1,7 +1,7 @@
 // kiln/file_watcher.hpp — one watcher for shaders, pipelines, scenes and modules.
 //
 // inotify on directories (a watch on a file is lost when an editor saves by rename),
-// recursive, polled without blocking once per frame on the render thread: no thread,
+// recursive or one directory alone, polled without blocking once per frame on the render thread: no thread,
 // no locks, and changes apply at a frame boundary by construction. A path is
 // reported once it has been quiet for the debounce interval (trailing edge) and only
 // if its content changed (FNV-1a of the bytes), so a burst of saves is one reload
@@ -29,9 +29,14 @@ public:
     FileWatcher(const FileWatcher&) = delete;
     FileWatcher& operator=(const FileWatcher&) = delete;
 
-    // Watches `dir` and (recursively) its subdirectories. Returns false if it does
-    // not exist.
-    bool watch(const std::filesystem::path& dir);
+    // Watches `dir` and, with Depth::Recursive, its subdirectories; with an
+    // `extension` (".json"), only the files that end so. Every file watched is hashed
+    // when first seen: the directory a pipeline or scene file sits in may be a home
+    // directory or /tmp, and is watched alone, for its JSON files (a scene in a 3.3 GB
+    // /tmp took 4.9 s to start when its directory was watched whole, recursively).
+    // Returns false if it does not exist.
+    enum class Depth { Recursive, ThisDirectory };
+    bool watch(const std::filesystem::path& dir, Depth depth = Depth::Recursive, const std::string& extension = {});
     // Files whose content changed and that have been quiet for the debounce interval.
     std::vector<std::filesystem::path> poll();
     bool usingInotify() const { return fd_ >= 0; }
@@ -43,9 +48,18 @@ private:
         uintmax_t size = 0;
         uint64_t inode = 0;
     };
-    // Watches `dir` recursively. firstSight: its files' contents are the baseline; else
-    // (a root that came back) each file is an event, reported if its content changed.
-    void addDirectory(const std::filesystem::path& dir, bool firstSight = true);
+    struct Watched {
+        std::filesystem::path dir;
+        Depth depth = Depth::Recursive;
+        std::string extension;  // empty: every file
+        bool covers(const std::filesystem::path& file) const {
+            return extension.empty() || file.extension() == extension;
+        }
+    };
+    // Watches `how.dir` (and its subdirectories if recursive). firstSight: its files'
+    // contents are the baseline; else (a root that came back) each file is an event,
+    // reported if its content changed.
+    void addDirectory(const Watched& how, bool firstSight = true);
     bool isWatched(const std::filesystem::path& dir) const;
     void noteEvent(const std::filesystem::path& file);
     void readEvents();  // drains inotify without blocking
@@ -56,8 +70,8 @@ private:
 
     int fd_ = -1;
     std::chrono::milliseconds debounce_;
-    std::vector<std::filesystem::path> roots_;
-    std::map<int, std::filesystem::path> watches_;  // inotify wd → directory
+    std::vector<Watched> roots_;
+    std::map<int, Watched> watches_;  // inotify wd → directory
     std::map<std::filesystem::path, Known> known_;  // every file seen, by content hash
     std::map<std::filesystem::path, Clock::time_point> pending_;  // path → last event
     Clock::time_point lastScan_{};
