@@ -1,6 +1,7 @@
 // gbuffer — draws every mesh of the scene into albedo, world-space normal, emitted
-// radiance and depth, the particles as point sprites shaded as spheres. The first pass
-// of every pipeline.
+// radiance and depth, the marbles and fireballs as spheres traced over their screen
+// rectangles, the particles as point sprites shaded as spheres. The first pass of
+// every pipeline.
 #include <kiln/pass.hpp>
 
 namespace {
@@ -20,7 +21,11 @@ public:
                        .doc = "the floor's grain baked over x, z in [-1,1] (2 mm texels), re-baked when its colours change"})
             .param(boolParam("particles", true, "draw the particles"))
             .param(enumParam("particle_mode", "points", {"points", "mesh"},
-                             "points: one point sprite per particle, shaded as a sphere; mesh: its octahedron"));
+                             "points: one point sprite per particle, shaded as a sphere; mesh: its octahedron"))
+            .param(enumParam("sphere_mode", "traced", {"traced", "mesh"},
+                             "the marbles and fireballs: traced = each pixel's ray against the sphere over its "
+                             "projected rectangle (exact silhouette, normal and depth; two triangles a sphere); "
+                             "mesh = their UV-sphere meshes by size on screen"));
         d.reads = kSceneStatic | kSceneBodies | kSceneParticles | kSceneCamera;
         return d;
     }
@@ -33,9 +38,13 @@ public:
         const bool particles = ctx.getBool("particles");
         const bool points = particles && ctx.getEnum("particle_mode") == "points";
         GLuint pointProgram = points ? ctx.program({.stages = {"gbuffer/particle.vert", "gbuffer/particle.frag"}}) : 0;
+        const bool tracedSpheres = ctx.getEnum("sphere_mode") == "traced";
+        GLuint sphereProgram = tracedSpheres ? ctx.program({.stages = {"gbuffer/sphere.vert", "gbuffer/sphere.frag"}}) : 0;
         GLuint bake = ctx.program({.stages = {"gbuffer/wood.comp"}});
         GLuint background = ctx.program({.stages = {"gbuffer/background.vert", "gbuffer/background.frag"}});
-        if (!program || !woodProgram || !bake || !background || (points && !pointProgram)) return;
+        if (!program || !woodProgram || !bake || !background || (points && !pointProgram) ||
+            (tracedSpheres && !sphereProgram))
+            return;
         // The floor's grain, baked: sampled through its mips it is the grain averaged
         // over each pixel, as the reference sees it (at 256²: floor relMSE 0.058
         // against 0.075 evaluated at pixel centres, SSIM 0.789 against 0.772), for
@@ -75,8 +84,12 @@ public:
             filter.categories &= ~kiln::kSceneBodies;
             glEnable(GL_CULL_FACE);
             glCullFace(GL_BACK);
-            ctx.drawScene({.categories = kiln::kSceneBodies});
+            ctx.drawScene({.categories = tracedSpheres ? kiln::kSceneTumblers : kiln::kSceneBodies});
             glDisable(GL_CULL_FACE);
+            if (tracedSpheres) {
+                drawTracedSpheres(ctx, sphereProgram);
+                glUseProgram(program);
+            }
             ctx.drawScene(filter);
             // The floor, the one wood-grained instance (a wall of the box).
             glUseProgram(woodProgram);
@@ -105,6 +118,20 @@ public:
     }
 
 private:
+    // sphere_mode traced: the marbles and the fireballs, each its screen rectangle.
+    void drawTracedSpheres(kiln::PassContext& ctx, GLuint sphereProgram) {
+        if (!pointsVao_) pointsVao_ = kiln::gl::createVertexArray();
+        glUseProgram(sphereProgram);
+        glBindVertexArray(pointsVao_.id());
+        for (kiln::SceneCategory spheres : {kiln::kSceneMarbles, kiln::kSceneFireballs}) {
+            const uint32_t count = ctx.scene().count(spheres);
+            if (count == 0) continue;
+            glUniform1ui(glGetUniformLocation(sphereProgram, "u_first"), ctx.scene().firstInstance(spheres));
+            glDrawArrays(GL_TRIANGLES, 0, GLsizei(6 * count));
+        }
+        glBindVertexArray(0);
+    }
+
     kiln::gl::VertexArrayHandle pointsVao_;  // attribute-less: the vertex shader reads the instance buffer
     // What the wood texture was last baked from (a cache: a reload starts over).
     GLuint bakedTexture_ = 0, bakedWith_ = 0;

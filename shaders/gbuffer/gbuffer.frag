@@ -1,6 +1,7 @@
 #version 450 core
 // G-buffer: albedo (sRGB-free linear rgb), world-space normal, emitted radiance.
 #include "common/frame.glsl"
+#include "gbuffer/highlight.glsl"
 
 layout(binding = 1) uniform sampler2D u_wood;  // the floor's grain over x, z in [-1,1] (gbuffer/wood.comp)
 
@@ -21,8 +22,7 @@ void main() {
 #endif
     vec3 n = normalize(v_normal);
     if (!gl_FrontFacing) n = -n;
-    vec3 emissive = v_emissive.rgb;
-    if (v_emissive.a > 0.5) emissive += vec3(0.25, 0.2, 0.05);  // the picked tumbler glows
+    vec3 emissive = emissionOf(v_emissive);
     o_albedo = vec4(albedo, 1.0);
     o_normal = vec4(n, 1.0);
     o_emissive = vec4(emissive, 1.0);

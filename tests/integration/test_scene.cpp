@@ -486,6 +486,87 @@ TEST_CASE("sphere level of detail: the silhouette stays within a pixel of the ci
     CHECK(scene::sphereLevelFor(500.0f) == 0);
 }
 
+TEST_CASE("gbuffer sphere_mode traced: each pixel shows a sphere exactly where its centre's ray hits it, with its normal and depth",
+          "[scene][gl]") {
+    // Checked against a ray-sphere intersection in double precision on the CPU, not the
+    // shader's own rectangle and arithmetic: a large marble close to the camera near the
+    // top right of the picture (its outline an ellipse stretched outwards, centred off
+    // its projected centre), a small one near the bottom left, a fireball in the middle.
+    // Every pixel whose centre's ray passes more than 0.1 % of a radius inside or outside
+    // a silhouette is counted; the rays are the camera's, through each pixel's centre.
+    const fs::path file = fs::path(TEST_OUTPUT_DIR) / "traced_spheres.json";
+    std::ofstream(file) << R"({"tumblers": [],
+        "marbles": [{"position": [0.55, 0.55, 0.6], "velocity": [0, 0, 0], "radius": 0.3, "color": [0.9, 0.2, 0.2]},
+                    {"position": [-0.75, -0.8, 0.7], "velocity": [0, 0, 0], "radius": 0.05, "color": [0.2, 0.9, 0.2]}],
+        "fireballs": [{"position": [0.0, 0.0, 0.0], "velocity": [0, 0, 0], "radius": 0.1, "color": [1.0, 0.5, 0.1]}]})";
+    const int size = 160;
+    Rig rig(file.string(), size);
+    std::string error;
+    REQUIRE(rig.app.runtime().setParam("gbuffer", "sphere_mode", ParamValue(std::string("traced")), error));
+    rig.app.frame();
+    auto read = [&](const char* name) {
+        const TextureRef* t = rig.app.runtime().findTexture("gbuffer", name);
+        REQUIRE(t);
+        return readTexture(t->id, t->target, t->format, t->width, t->height);
+    };
+    const FloatImage normals = read("normal"), depths = read("depth");
+    const glm::dmat4 proj = glm::dmat4(rig.app.camera().projection(1.0f));
+    const glm::dmat4 invViewProj = glm::inverse(glm::dmat4(rig.app.viewProj()));
+    const glm::dvec3 eye = glm::dvec3(rig.app.camera().position());
+    const auto& balls = rig.app.scene().sim().balls();
+    REQUIRE(balls.size() == 3);
+    int hits = 0, misses = 0, wrongCover = 0, wrongNormal = 0, wrongDepth = 0;
+    double worstNormal = 0.0, worstDepth = 0.0;
+    for (int y = 0; y < size; ++y)
+        for (int x = 0; x < size; ++x) {
+            const glm::dvec2 ndc = (glm::dvec2(x, y) + 0.5) / double(size) * 2.0 - 1.0;
+            const glm::dvec4 far = invViewProj * glm::dvec4(ndc, 1.0, 1.0);
+            const glm::dvec3 dir = glm::normalize(glm::dvec3(far) / far.w - eye);
+            double nearest = std::numeric_limits<double>::infinity();
+            glm::dvec3 normal(0.0);
+            bool nearSilhouette = false;
+            for (const sim::Ball& ball : balls) {
+                const glm::dvec3 toCentre = glm::dvec3(ball.position) - eye;
+                const double along = glm::dot(toCentre, dir);
+                const double offAxis = glm::length(toCentre - along * dir);
+                if (std::abs(offAxis - ball.radius) < 1e-3 * ball.radius) nearSilhouette = true;
+                if (offAxis >= ball.radius) continue;
+                const double t = along - std::sqrt(ball.radius * ball.radius - offAxis * offAxis);
+                if (t < nearest) nearest = t, normal = (eye + t * dir - glm::dvec3(ball.position)) / ball.radius;
+            }
+            // The lamp's dome (the part of its ball below the ceiling) is curved too: not counted.
+            const sim::Scene::Lamp& lamp = rig.app.scene().sim().scene().lamp;
+            const glm::dvec3 toLamp = lamp.center - eye;
+            const bool onLamp = glm::length(toLamp - glm::dot(toLamp, dir) * dir) < lamp.radius * 1.001;
+            if (nearSilhouette || onLamp) continue;
+            const auto n = normals.at(x, y);
+            // The walls' normals are the axes; a sphere's is one only at a single point.
+            const bool showsWall = std::max({std::abs(n[0]), std::abs(n[1]), std::abs(n[2])}) > 0.9999f;
+            if (!std::isfinite(nearest)) {
+                ++misses;
+                wrongCover += !showsWall;
+                continue;
+            }
+            ++hits;
+            const double normalError = glm::length(glm::dvec3(n[0], n[1], n[2]) - normal);
+            worstNormal = std::max(worstNormal, normalError);
+            wrongNormal += normalError > 2e-3;  // stored as halves: 5e-4 a component
+            // The view depth from the window depth, against the hit's.
+            const double viewDepth = -(glm::dmat4(rig.app.camera().view()) * glm::dvec4(eye + nearest * dir, 1.0)).z;
+            const double stored = proj[3][2] / ((2.0 * depths.at(x, y)[0] - 1.0) + proj[2][2]);
+            worstDepth = std::max(worstDepth, std::abs(stored - viewDepth));
+            wrongDepth += std::abs(stored - viewDepth) > 1e-4 * viewDepth;  // a tenth of a millimetre a metre
+        }
+    INFO(hits << " pixels on a sphere, " << misses << " off; " << wrongCover << " covered wrongly, " << wrongNormal
+              << " with a wrong normal (worst " << worstNormal << "), " << wrongDepth << " at a wrong depth (worst "
+              << worstDepth << " m)");
+    CHECK(hits > 1500);  // the large marble alone spans about 45 px across
+    CHECK(misses > 10000);
+    CHECK(wrongCover == 0);
+    CHECK(wrongNormal == 0);
+    CHECK(wrongDepth == 0);
+}
+
 namespace {
 // Points across every triangle of a mesh: a barycentric grid of 8 steps an edge (45 a
 // triangle, its corners and edges included), each passed to `visit`.
