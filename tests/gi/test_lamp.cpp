@@ -546,3 +546,69 @@ TEST_CASE("composite keep_direct: where most of the picture moves it is drawn wh
     INFO("most values differing in a frame: " << worst);
     CHECK(worst == 0);
 }
+
+TEST_CASE("composite keep_direct: drawn whole, it counts the moved tiles every few runs and is back in tiles while "
+          "fewer move",
+          "[gi][composite]") {
+    // Drawing whole, composite marks and counts the moved tiles only every
+    // kCountWholeEvery-th run (8). Sixty fireballs send it to the whole picture; then
+    // one rolling marble replaces them (a scene load: every pixel recomputed once) and,
+    // while it still moves, composite must come back to tiles within a count's period
+    // or two, then recompute only part of the picture. Every frame equal exactly to a
+    // rig recomputing every pixel.
+    nlohmann::json fire = nlohmann::json::array();
+    for (int i = 0; i < 60; ++i) {
+        const double a = 2.399963 * i;
+        fire.push_back({{"position", {-0.8 + 0.4 * (i % 5), -0.7 + 0.45 * ((i / 5) % 4), -0.6 + 0.5 * (i / 20)}},
+                        {"velocity", {0.9 * std::cos(a), 0.2, 0.9 * std::sin(a)}},
+                        {"radius", 0.1},
+                        {"color", {1.0, 0.5, 0.1}}});
+    }
+    nlohmann::json scene = nlohmann::json::parse(std::ifstream(KILN_SOURCE_DIR "/scenes/cornell.json"));
+    scene["fireballs"] = fire;
+    const std::string fireFile = test::writeScene("sixty_fireballs_then_one_marble.json", scene.dump());
+    const std::string marbleFile = test::writeScene(
+        "one_rolling_marble.json",
+        R"({"tumblers": [], "fireballs": [], "marbles": [{"position": [-0.5, -0.95, 0.2], "velocity": [0.6, 0.0, 0.1],
+                                                          "radius": 0.05, "color": [0.9, 0.9, 0.95]}]})");
+    test::Rig kept(fireFile, 128), whole(fireFile, 128);
+    loadKeepingDirect(kept, true);
+    loadKeepingDirect(whole, false);
+    size_t worst = 0;
+    float lastNewest = -1.0f;
+    enum class Drawn { Whole, AllRecomputed, Part };
+    auto step = [&] {
+        kept.app.frame();
+        whole.app.frame();
+        worst = std::max(worst, differingValues(kept, whole, "hdr"));
+        const FloatImage direct = kept.image("composite", "direct");
+        const float newest = newestKeptFrame(direct);
+        size_t atNewest = 0;
+        for (size_t i = 3; i < direct.pixels.size(); i += 4) atNewest += direct.pixels[i] == newest;
+        const bool sameNewest = newest == lastNewest;
+        lastNewest = newest;
+        return sameNewest ? Drawn::Whole : atNewest == direct.pixels.size() / 4 ? Drawn::AllRecomputed : Drawn::Part;
+    };
+    kept.app.paused = whole.app.paused = false;
+    int drawnWhole = 0;
+    for (int frame = 0; frame < 20; ++frame) drawnWhole += step() == Drawn::Whole;
+    INFO(drawnWhole << " of 20 frames with sixty fireballs drawn whole");
+    REQUIRE(drawnWhole >= 10);
+    std::string error;
+    REQUIRE(kept.app.scene().load(marbleFile, kept.app.seedOverride(), error));
+    REQUIRE(whole.app.scene().load(marbleFile, whole.app.seedOverride(), error));
+    int backAt = -1, partly = 0;
+    for (int frame = 0; frame < 24; ++frame) {
+        const Drawn drawn = step();
+        if (backAt < 0 && drawn == Drawn::AllRecomputed) backAt = frame;
+        if (backAt >= 0 && frame > backAt) partly += drawn == Drawn::Part;
+    }
+    kept.checkNoErrors();
+    whole.checkNoErrors();
+    INFO("back in tiles at frame " << backAt << " after the load, then " << partly << " frames recomputing part");
+    CHECK(backAt >= 0);
+    CHECK(backAt <= 2 * 8);
+    CHECK(partly >= 4);
+    INFO("most values differing in a frame: " << worst);
+    CHECK(worst == 0);
+}
