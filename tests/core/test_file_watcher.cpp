@@ -48,6 +48,16 @@ std::vector<fs::path> pollUntilReported(FileWatcher& watcher, const fs::path& fi
     return reported;
 }
 
+// Changes the file below the root and the .txt first, scene.json last (had the others
+// been watched, they would have settled no later), and returns what was reported by the
+// time scene.json was.
+std::vector<fs::path> changeEveryFile(const WatchedTree& tree, FileWatcher& watcher) {
+    tree.write("sub/deep.json", "{\"changed\": 1}");
+    tree.write("notes.txt", "changed");
+    tree.write("scene.json", "{\"changed\": 1}");
+    return pollUntilReported(watcher, fs::weakly_canonical(tree.root) / "scene.json");
+}
+
 bool contains(const std::vector<fs::path>& paths, const fs::path& p) {
     return std::find(paths.begin(), paths.end(), p) != paths.end();
 }
@@ -59,11 +69,7 @@ TEST_CASE("a directory watched alone for .json reports its JSON files, not its s
     FileWatcher watcher;
     REQUIRE(watcher.watch(tree.root, FileWatcher::Depth::ThisDirectory, ".json"));
     const fs::path root = fs::weakly_canonical(tree.root);
-    // The others first: had they been watched, they would have settled first.
-    tree.write("sub/deep.json", "{\"changed\": 1}");
-    tree.write("notes.txt", "changed");
-    tree.write("scene.json", "{\"changed\": 1}");
-    const std::vector<fs::path> reported = pollUntilReported(watcher, root / "scene.json");
+    const std::vector<fs::path> reported = changeEveryFile(tree, watcher);
     CHECK(contains(reported, root / "scene.json"));
     CHECK_FALSE(contains(reported, root / "sub/deep.json"));
     CHECK_FALSE(contains(reported, root / "notes.txt"));
@@ -81,11 +87,7 @@ TEST_CASE("a directory watched recursively reports its subdirectories' files too
     FileWatcher watcher;
     REQUIRE(watcher.watch(tree.root));
     const fs::path root = fs::weakly_canonical(tree.root);
-    tree.write("sub/deep.json", "{\"changed\": 1}");
-    tree.write("notes.txt", "changed");
-    tree.write("scene.json", "{\"changed\": 1}");
-    const std::vector<fs::path> reported = pollUntilReported(watcher, root / "scene.json");
-    // Written before scene.json, they settle no later: reported in the same poll or before.
+    const std::vector<fs::path> reported = changeEveryFile(tree, watcher);
     CHECK(contains(reported, root / "sub/deep.json"));
     CHECK(contains(reported, root / "notes.txt"));
     CHECK(contains(reported, root / "scene.json"));

@@ -495,13 +495,10 @@ TEST_CASE("composite keep_direct: a still tumbler in a moving marble's shadow is
     CHECK(worst == 0);
 }
 
-TEST_CASE("composite keep_direct: where most of the picture moves it is drawn whole, and back in tiles once still",
-          "[gi][composite]") {
-    // Sixty fireballs and their particles move over most of the tiles: drawing them in
-    // tiles would cost more than the whole picture, so composite draws it whole (nothing
-    // kept: `direct` is not written, its newest frame stands still). Paused, it draws
-    // in tiles again: first all of them recomputed, then none. Every frame equal exactly
-    // to a rig recomputing every pixel.
+namespace {
+// The shipped scene with sixty fireballs (10 cm, in a 5 × 4 × 3 lattice, flying every
+// way) in place of its two: their particles move over most of composite's tiles.
+std::string sixtyFireballsScene(const std::string& name) {
     nlohmann::json scene = nlohmann::json::parse(std::ifstream(KILN_SOURCE_DIR "/scenes/cornell.json"));
     nlohmann::json fire = nlohmann::json::array();
     for (int i = 0; i < 60; ++i) {
@@ -512,39 +509,60 @@ TEST_CASE("composite keep_direct: where most of the picture moves it is drawn wh
                         {"color", {1.0, 0.5, 0.1}}});
     }
     scene["fireballs"] = fire;
-    const std::string file = test::writeScene("sixty_fireballs.json", scene.dump());
-    test::Rig kept(file, 128), whole(file, 128);
-    loadKeepingDirect(kept, true);
-    loadKeepingDirect(whole, false);
+    return test::writeScene(name, scene.dump());
+}
+
+// Two rigs on one scene, composite keeping its lamp light in one and recomputing every
+// pixel in the other, stepped together: how the kept one drew each frame, read from its
+// kept light's alpha (the frame that computed it), and the most values of `hdr` that
+// ever differed between them.
+struct KeptAgainstWhole {
+    enum class Drawn { Whole, AllRecomputed, Part };
+    test::Rig kept, whole;
     size_t worst = 0;
-    int drawnWhole = 0, recomputedAll = 0;
     float lastNewest = -1.0f;
-    auto step = [&] {
+    explicit KeptAgainstWhole(const std::string& scene) : kept(scene, 128), whole(scene, 128) {
+        loadKeepingDirect(kept, true);
+        loadKeepingDirect(whole, false);
+    }
+    void setPaused(bool paused) { kept.app.paused = whole.app.paused = paused; }
+    Drawn step() {
         kept.app.frame();
         whole.app.frame();
         worst = std::max(worst, differingValues(kept, whole, "hdr"));
-        // The kept light's alpha: the frame that computed it.
         const FloatImage direct = kept.image("composite", "direct");
         const float newest = newestKeptFrame(direct);
         size_t atNewest = 0;
         for (size_t i = 3; i < direct.pixels.size(); i += 4) atNewest += direct.pixels[i] == newest;
-        drawnWhole += newest == lastNewest;
-        recomputedAll += newest != lastNewest && atNewest == direct.pixels.size() / 4;
+        const bool sameNewest = newest == lastNewest;  // nothing kept this frame: drawn whole
         lastNewest = newest;
-    };
-    kept.app.paused = whole.app.paused = false;
-    for (int frame = 0; frame < 30; ++frame) step();
+        return sameNewest ? Drawn::Whole : atNewest == direct.pixels.size() / 4 ? Drawn::AllRecomputed : Drawn::Part;
+    }
+};
+}  // namespace
+
+TEST_CASE("composite keep_direct: where most of the picture moves it is drawn whole, and back in tiles once still",
+          "[gi][composite]") {
+    // Sixty fireballs and their particles move over most of the tiles: drawing them in
+    // tiles would cost more than the whole picture, so composite draws it whole (nothing
+    // kept: `direct` is not written, its newest frame stands still). Paused, it draws
+    // in tiles again: first all of them recomputed, then none. Every frame equal exactly
+    // to a rig recomputing every pixel.
+    KeptAgainstWhole rigs(sixtyFireballsScene("sixty_fireballs.json"));
+    using Drawn = KeptAgainstWhole::Drawn;
+    rigs.setPaused(false);
+    int drawnWhole = 0, recomputedAll = 0;
+    for (int frame = 0; frame < 30; ++frame) drawnWhole += rigs.step() == Drawn::Whole;
     // Measured: 53 to 58 of the 64 tiles moved in each frame; 25 frames drawn whole.
     INFO(drawnWhole << " of 30 moving frames drawn whole");
     CHECK(drawnWhole >= 10);
-    kept.app.paused = whole.app.paused = true;
-    recomputedAll = 0;
-    for (int frame = 0; frame < 4; ++frame) step();
-    kept.checkNoErrors();
-    whole.checkNoErrors();
+    rigs.setPaused(true);
+    for (int frame = 0; frame < 4; ++frame) recomputedAll += rigs.step() == Drawn::AllRecomputed;
+    rigs.kept.checkNoErrors();
+    rigs.whole.checkNoErrors();
     CHECK(recomputedAll == 1);
-    INFO("most values differing in a frame: " << worst);
-    CHECK(worst == 0);
+    INFO("most values differing in a frame: " << rigs.worst);
+    CHECK(rigs.worst == 0);
 }
 
 TEST_CASE("composite keep_direct: drawn whole, it counts the moved tiles every few runs and is back in tiles while "
@@ -556,59 +574,32 @@ TEST_CASE("composite keep_direct: drawn whole, it counts the moved tiles every f
     // while it still moves, composite must come back to tiles within a count's period
     // or two, then recompute only part of the picture. Every frame equal exactly to a
     // rig recomputing every pixel.
-    nlohmann::json fire = nlohmann::json::array();
-    for (int i = 0; i < 60; ++i) {
-        const double a = 2.399963 * i;
-        fire.push_back({{"position", {-0.8 + 0.4 * (i % 5), -0.7 + 0.45 * ((i / 5) % 4), -0.6 + 0.5 * (i / 20)}},
-                        {"velocity", {0.9 * std::cos(a), 0.2, 0.9 * std::sin(a)}},
-                        {"radius", 0.1},
-                        {"color", {1.0, 0.5, 0.1}}});
-    }
-    nlohmann::json scene = nlohmann::json::parse(std::ifstream(KILN_SOURCE_DIR "/scenes/cornell.json"));
-    scene["fireballs"] = fire;
-    const std::string fireFile = test::writeScene("sixty_fireballs_then_one_marble.json", scene.dump());
     const std::string marbleFile = test::writeScene(
         "one_rolling_marble.json",
         R"({"tumblers": [], "fireballs": [], "marbles": [{"position": [-0.5, -0.95, 0.2], "velocity": [0.6, 0.0, 0.1],
                                                           "radius": 0.05, "color": [0.9, 0.9, 0.95]}]})");
-    test::Rig kept(fireFile, 128), whole(fireFile, 128);
-    loadKeepingDirect(kept, true);
-    loadKeepingDirect(whole, false);
-    size_t worst = 0;
-    float lastNewest = -1.0f;
-    enum class Drawn { Whole, AllRecomputed, Part };
-    auto step = [&] {
-        kept.app.frame();
-        whole.app.frame();
-        worst = std::max(worst, differingValues(kept, whole, "hdr"));
-        const FloatImage direct = kept.image("composite", "direct");
-        const float newest = newestKeptFrame(direct);
-        size_t atNewest = 0;
-        for (size_t i = 3; i < direct.pixels.size(); i += 4) atNewest += direct.pixels[i] == newest;
-        const bool sameNewest = newest == lastNewest;
-        lastNewest = newest;
-        return sameNewest ? Drawn::Whole : atNewest == direct.pixels.size() / 4 ? Drawn::AllRecomputed : Drawn::Part;
-    };
-    kept.app.paused = whole.app.paused = false;
+    KeptAgainstWhole rigs(sixtyFireballsScene("sixty_fireballs_then_one_marble.json"));
+    using Drawn = KeptAgainstWhole::Drawn;
+    rigs.setPaused(false);
     int drawnWhole = 0;
-    for (int frame = 0; frame < 20; ++frame) drawnWhole += step() == Drawn::Whole;
+    for (int frame = 0; frame < 20; ++frame) drawnWhole += rigs.step() == Drawn::Whole;
     INFO(drawnWhole << " of 20 frames with sixty fireballs drawn whole");
     REQUIRE(drawnWhole >= 10);
     std::string error;
-    REQUIRE(kept.app.scene().load(marbleFile, kept.app.seedOverride(), error));
-    REQUIRE(whole.app.scene().load(marbleFile, whole.app.seedOverride(), error));
+    REQUIRE(rigs.kept.app.scene().load(marbleFile, rigs.kept.app.seedOverride(), error));
+    REQUIRE(rigs.whole.app.scene().load(marbleFile, rigs.whole.app.seedOverride(), error));
     int backAt = -1, partly = 0;
     for (int frame = 0; frame < 24; ++frame) {
-        const Drawn drawn = step();
+        const Drawn drawn = rigs.step();
         if (backAt < 0 && drawn == Drawn::AllRecomputed) backAt = frame;
         if (backAt >= 0 && frame > backAt) partly += drawn == Drawn::Part;
     }
-    kept.checkNoErrors();
-    whole.checkNoErrors();
+    rigs.kept.checkNoErrors();
+    rigs.whole.checkNoErrors();
     INFO("back in tiles at frame " << backAt << " after the load, then " << partly << " frames recomputing part");
     CHECK(backAt >= 0);
     CHECK(backAt <= 2 * 8);
     CHECK(partly >= 4);
-    INFO("most values differing in a frame: " << worst);
-    CHECK(worst == 0);
+    INFO("most values differing in a frame: " << rigs.worst);
+    CHECK(rigs.worst == 0);
 }
