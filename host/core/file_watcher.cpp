@@ -111,10 +111,12 @@ void FileWatcher::rescan() {
     // After an overflow (or in polling mode): anything whose identity changed is an event.
     for (const Watched& root : roots_) {
         std::error_code ec;
-        for (auto it = fs::recursive_directory_iterator(root.dir, ec); it != fs::recursive_directory_iterator(); it.increment(ec)) {
+        for (auto it = fs::recursive_directory_iterator(root.dir, ec); it != fs::recursive_directory_iterator();
+             it.increment(ec)) {
             if (ec) break;
             if (root.depth == Depth::ThisDirectory) it.disable_recursion_pending();
-            if (!root.covers(it->path()) || !it->is_regular_file(ec) || isNoise(it->path().filename().string())) continue;
+            if (!root.covers(it->path()) || !it->is_regular_file(ec) || isNoise(it->path().filename().string()))
+                continue;
             auto found = known_.find(it->path());
             const auto mtime = fs::last_write_time(it->path(), ec);
             const auto size = fs::file_size(it->path(), ec);

@@ -316,7 +316,8 @@ private:
         // No instance moved since the last run (the scene paused or asleep): none of
         // the tiles would be marked.
         uint64_t instances = 0;
-        for (kiln::SceneCategory c : {kiln::kSceneTumblers, kiln::kSceneMarbles, kiln::kSceneFireballs, kiln::kSceneParticles})
+        for (kiln::SceneCategory c :
+             {kiln::kSceneTumblers, kiln::kSceneMarbles, kiln::kSceneFireballs, kiln::kSceneParticles})
             instances = instances * 1000003u + scene.version(c);
         if (instances == instancesSeen_) movedShare_ = 0.0;
         instancesSeen_ = instances;

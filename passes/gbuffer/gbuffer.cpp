@@ -39,7 +39,8 @@ public:
         const bool points = particles && ctx.getEnum("particle_mode") == "points";
         GLuint pointProgram = points ? ctx.program({.stages = {"gbuffer/particle.vert", "gbuffer/particle.frag"}}) : 0;
         const bool tracedSpheres = ctx.getEnum("sphere_mode") == "traced";
-        GLuint sphereProgram = tracedSpheres ? ctx.program({.stages = {"gbuffer/sphere.vert", "gbuffer/sphere.frag"}}) : 0;
+        GLuint sphereProgram =
+            tracedSpheres ? ctx.program({.stages = {"gbuffer/sphere.vert", "gbuffer/sphere.frag"}}) : 0;
         GLuint bake = ctx.program({.stages = {"gbuffer/wood.comp"}});
         GLuint background = ctx.program({.stages = {"gbuffer/background.vert", "gbuffer/background.frag"}});
         if (!program || !woodProgram || !bake || !background || (points && !pointProgram) ||

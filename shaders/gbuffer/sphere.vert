@@ -52,5 +52,6 @@ void main() {
     ivec2 corner = kCorners[gl_VertexID % 6];
     vec2 ndc = mix(lo, hi, vec2(corner));
     gl_Position = vec4(ndc, 0.0, 1.0);
-    v_ray = transpose(mat3(u_view)) * vec3((ndc + vec2(u_proj[2][0], u_proj[2][1])) / vec2(u_proj[0][0], u_proj[1][1]), -1.0);
+    vec2 slope = (ndc + vec2(u_proj[2][0], u_proj[2][1])) / vec2(u_proj[0][0], u_proj[1][1]);  // x / depth, y / depth
+    v_ray = transpose(mat3(u_view)) * vec3(slope, -1.0);
 }

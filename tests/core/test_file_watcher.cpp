@@ -33,7 +33,9 @@ struct WatchedTree {
         std::error_code ec;
         fs::remove_all(root, ec);
     }
-    void write(const std::string& file, const std::string& text) const { std::ofstream(root / file, std::ios::trunc) << text; }
+    void write(const std::string& file, const std::string& text) const {
+        std::ofstream(root / file, std::ios::trunc) << text;
+    }
 };
 
 // Polls until `file` is reported (or 30 s pass) and returns every path reported by then.

@@ -486,7 +486,8 @@ TEST_CASE("sphere level of detail: the silhouette stays within a pixel of the ci
     CHECK(scene::sphereLevelFor(500.0f) == 0);
 }
 
-TEST_CASE("gbuffer sphere_mode traced: each pixel shows a sphere exactly where its centre's ray hits it, with its normal and depth",
+TEST_CASE("gbuffer sphere_mode traced: each pixel shows a sphere exactly where its centre's ray hits it, with its "
+          "normal and depth",
           "[scene][gl]") {
     // Checked against a ray-sphere intersection in double precision on the CPU, not the
     // shader's own rectangle and arithmetic: a large marble close to the camera near the
