@@ -315,10 +315,9 @@ private:
         }
         // No instance moved since the last run (the scene paused or asleep): none of
         // the tiles would be marked.
-        uint64_t instances = 0;
-        for (kiln::SceneCategory c :
-             {kiln::kSceneTumblers, kiln::kSceneMarbles, kiln::kSceneFireballs, kiln::kSceneParticles})
-            instances = instances * 1000003u + scene.version(c);
+        const std::array<uint64_t, 4> instances{scene.version(kiln::kSceneTumblers), scene.version(kiln::kSceneMarbles),
+                                                scene.version(kiln::kSceneFireballs),
+                                                scene.version(kiln::kSceneParticles)};
         if (instances == instancesSeen_) movedShare_ = 0.0;
         instancesSeen_ = instances;
         // Back from the whole at a lower share than away to it: the first run in tiles
@@ -507,7 +506,7 @@ private:
     static constexpr uint32_t kCountWholeEvery = 8;
     bool drawingWhole_ = false;
     uint32_t wholeRuns_ = 0;                // runs drawn whole in a row
-    uint64_t instancesSeen_ = 0;            // the moving categories' versions at the last run
+    std::array<uint64_t, 4> instancesSeen_{};  // the moving categories' versions at the last run
     std::optional<CacheKey> cacheKey_;      // what the kept light was computed from; empty: nothing kept
     kiln::gl::Buffer previous_;             // the instances at the last run
     uint32_t previousEnd_ = 0;              // how many there were

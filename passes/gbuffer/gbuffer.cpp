@@ -101,12 +101,11 @@ public:
             // (4 000 octahedra cost the G-buffer 15 ms at 720² on llvmpipe).
             const uint32_t count = ctx.scene().count(kiln::kSceneParticles);
             if (points && count > 0) {
-                if (!pointsVao_) pointsVao_ = kiln::gl::createVertexArray();
                 glUseProgram(pointProgram);
                 glUniform1ui(glGetUniformLocation(pointProgram, "u_first"),
                              ctx.scene().firstInstance(kiln::kSceneParticles));
                 glEnable(GL_PROGRAM_POINT_SIZE);
-                glBindVertexArray(pointsVao_.id());
+                glBindVertexArray(emptyVertexArray());
                 glDrawArrays(GL_POINTS, 0, GLsizei(count));
                 glBindVertexArray(0);
                 glDisable(GL_PROGRAM_POINT_SIZE);
@@ -119,21 +118,25 @@ public:
     }
 
 private:
-    // sphere_mode traced: the marbles and the fireballs, each its screen rectangle.
+    // sphere_mode traced: the marbles and the fireballs (neighbours in the instance
+    // buffer, which holds the categories in bit order), each its screen rectangle.
     void drawTracedSpheres(kiln::PassContext& ctx, GLuint sphereProgram) {
-        if (!pointsVao_) pointsVao_ = kiln::gl::createVertexArray();
+        const uint32_t count = ctx.scene().count(kiln::kSceneMarbles | kiln::kSceneFireballs);
+        if (count == 0) return;
         glUseProgram(sphereProgram);
-        glBindVertexArray(pointsVao_.id());
-        for (kiln::SceneCategory spheres : {kiln::kSceneMarbles, kiln::kSceneFireballs}) {
-            const uint32_t count = ctx.scene().count(spheres);
-            if (count == 0) continue;
-            glUniform1ui(glGetUniformLocation(sphereProgram, "u_first"), ctx.scene().firstInstance(spheres));
-            glDrawArrays(GL_TRIANGLES, 0, GLsizei(6 * count));
-        }
+        glUniform1ui(glGetUniformLocation(sphereProgram, "u_first"), ctx.scene().firstInstance(kiln::kSceneMarbles));
+        glBindVertexArray(emptyVertexArray());
+        glDrawArrays(GL_TRIANGLES, 0, GLsizei(6 * count));
         glBindVertexArray(0);
     }
 
-    kiln::gl::VertexArrayHandle pointsVao_;  // attribute-less: the vertex shader reads the instance buffer
+    // Attribute-less: the particles' and spheres' vertex shaders read the instance buffer.
+    GLuint emptyVertexArray() {
+        if (!emptyVao_) emptyVao_ = kiln::gl::createVertexArray();
+        return emptyVao_.id();
+    }
+
+    kiln::gl::VertexArrayHandle emptyVao_;
     // What the wood texture was last baked from (a cache: a reload starts over).
     GLuint bakedTexture_ = 0, bakedWith_ = 0;
     glm::vec4 bakedLight_{-1.0f}, bakedDark_{-1.0f};
