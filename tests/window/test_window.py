@@ -211,6 +211,13 @@ try:
     high = screen_pixel(cx1 - 4, cy1 - 4, os.path.join(OUT, "histogram.png"))
     check(middle[1] > 150 and middle[1] > middle[0] and middle[1] > middle[2], "the legend is green midway: %s" % middle)
     check(high[0] > 100 and high[0] > 3 * high[2], "the legend ends red: %s" % high)
+    # The sidebar, clicked since, lies over the legend's low end and hides it: it draws
+    # its background whenever another window overlaps its column (only then: elsewhere
+    # the window's clear stands in for it). Transparent, the legend's blue shows through.
+    ix = p["image"][0]
+    check(cx0 < ix - 40, "the texture window reaches under the sidebar's column: %d < %d" % (cx0, ix))
+    under = screen_pixel((cx0 + ix) // 2, cy1 - 4, os.path.join(OUT, "histogram.png"))
+    check(max(under) < 40, "the sidebar hides the legend under it: %s" % under)
 
     # 3. A parameter: ctrl+click composite.exposure, type 0.25; the image darkens.
     before = image_mean(screenshot("before.png"), probe())
