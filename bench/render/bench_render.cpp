@@ -330,24 +330,38 @@ void report(const Config& config, Measured& m, double floorMs, std::ofstream& cs
 }  // namespace
 
 // growth.csv and growth.png: frame cost against the grown body count, per pipeline.
+// `ratio` divides the medians over rounds; `paired` is the median over rounds of each
+// round's ratio to the first count measured in the same round, with its lowest and
+// highest: the machine's speed drifts between rounds by more than the two frames
+// differ within one (on the 2-core machine, ±10 % from minute to minute).
 void reportGrowth(const Args& args, const std::vector<Config>& configs, std::vector<Measured>& measured) {
     const std::string csvPath = (fs::path(args.outDir) / "growth.csv").string();
     std::ofstream csv(csvPath);
-    csv << "pipeline," << args.growKind << ",particles,frame_ms,ratio,voxelize_ms,gbuffer_ms,shadow_ms\n";
-    std::printf("growth: frame cost against %s (ratio to the first count of the same pipeline)\n", args.growKind.c_str());
-    std::printf("  %-10s %9s %10s %9s %7s %11s %10s %9s\n", "pipeline", args.growKind.c_str(), "particles", "frame ms",
-                "ratio", "voxelize ms", "gbuffer ms", "shadow ms");
-    std::map<std::string, double> base;
+    csv << "pipeline," << args.growKind
+        << ",particles,frame_ms,ratio,voxelize_ms,gbuffer_ms,shadow_ms,paired_ratio,paired_min,paired_max\n";
+    std::printf("growth: frame cost against %s (ratio to the first count of the same pipeline; paired: the median, "
+                "lowest and highest of each round's ratio)\n", args.growKind.c_str());
+    std::printf("  %-10s %9s %10s %9s %7s %11s %10s %9s  %s\n", "pipeline", args.growKind.c_str(), "particles", "frame ms",
+                "ratio", "voxelize ms", "gbuffer ms", "shadow ms", "paired (min-max)");
+    std::map<std::string, size_t> base;  // the pipeline's first count's index
     for (size_t i = 0; i < configs.size(); ++i) {
         const std::string pipeline = fs::path(configs[i].pipeline).stem().string();
         Measured& m = measured[i];
-        const double frame = median(m.frameMs);
-        if (!base.count(pipeline)) base[pipeline] = frame;
+        if (!base.count(pipeline)) base[pipeline] = i;
+        const Measured& b = measured[base[pipeline]];
+        const double frame = median(m.frameMs), ratio = frame / median(b.frameMs);
+        std::vector<double> rounds;  // frameMs holds one median a round, in the rounds' order
+        for (size_t r = 0; r < m.frameMs.size() && r < b.frameMs.size(); ++r) rounds.push_back(m.frameMs[r] / b.frameMs[r]);
+        if (rounds.empty()) rounds.push_back(ratio);
+        const double paired = median(rounds);
+        const auto [low, high] = std::minmax_element(rounds.begin(), rounds.end());
         auto gpu = [&](const char* id) { return m.gpu.count(id) ? median(m.gpu[id]) : 0.0; };
-        std::printf("  %-10s %9d %10.0f %9.2f %7.2f %11.2f %10.2f %9.2f\n", pipeline.c_str(), configs[i].grown,
-                    median(m.particles), frame, frame / base[pipeline], gpu("voxelize"), gpu("gbuffer"), gpu("shadow"));
-        csv << pipeline << "," << configs[i].grown << "," << median(m.particles) << "," << frame << ","
-            << frame / base[pipeline] << "," << gpu("voxelize") << "," << gpu("gbuffer") << "," << gpu("shadow") << "\n";
+        std::printf("  %-10s %9d %10.0f %9.2f %7.2f %11.2f %10.2f %9.2f  %.2f (%.2f-%.2f)\n", pipeline.c_str(),
+                    configs[i].grown, median(m.particles), frame, ratio, gpu("voxelize"), gpu("gbuffer"), gpu("shadow"),
+                    paired, *low, *high);
+        csv << pipeline << "," << configs[i].grown << "," << median(m.particles) << "," << frame << "," << ratio << ","
+            << gpu("voxelize") << "," << gpu("gbuffer") << "," << gpu("shadow") << "," << paired << "," << *low << ","
+            << *high << "\n";
     }
     csv.close();  // complete on disk before the plot script reads it
     std::string error;

@@ -142,11 +142,12 @@ TEST_CASE("kiln-bench-render --grow: one growth row per count, the first the bas
     std::istringstream csv(slurp(out + "/growth.csv"));
     std::string line;
     std::getline(csv, line);
-    CHECK(line == "pipeline,fireballs,particles,frame_ms,ratio,voxelize_ms,gbuffer_ms,shadow_ms");
+    CHECK(line == "pipeline,fireballs,particles,frame_ms,ratio,voxelize_ms,gbuffer_ms,shadow_ms,paired_ratio,paired_min,"
+                  "paired_max");
     std::vector<std::vector<double>> rows;
     while (std::getline(csv, line)) {
         std::istringstream cells(line.substr(line.find(',') + 1));
-        std::vector<double> v(7);
+        std::vector<double> v(10);
         char comma;
         for (double& x : v) cells >> x >> comma;
         rows.push_back(v);
@@ -157,6 +158,11 @@ TEST_CASE("kiln-bench-render --grow: one growth row per count, the first the bas
     CHECK(rows[0][1] == 0);   // no fireball, no fire
     CHECK(rows[1][1] > 0);    // 0.3 s of four fireballs: particles
     CHECK(rows[0][3] == 1.0); // the baseline's ratio
+    CHECK(rows[0][7] == 1.0); // and paired with itself, round by round
+    // One round: its ratio is the ratio of the medians, its lowest and highest too.
+    CHECK(rows[1][7] == Approx(rows[1][3]).epsilon(1e-5));
+    CHECK(rows[1][8] == Approx(rows[1][7]).epsilon(1e-5));
+    CHECK(rows[1][9] == Approx(rows[1][7]).epsilon(1e-5));
     for (auto& v : rows)
         for (double x : v) CHECK(std::isfinite(x));
     CHECK(std::filesystem::file_size(out + "/growth.png") > 1000);
