@@ -9,6 +9,7 @@
 // model) is far off.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -322,6 +323,107 @@ TEST_CASE("lamp: from its field (one lookup a pixel), the lamp's light is the pe
     std::string error;
     REQUIRE(rig.app.scene().load(test::writeScene("moved_lamp.json", moved.dump()), std::nullopt, error));
     compare({0.3, 1.05, -0.2});
+}
+
+TEST_CASE("lamp: the shadow filter is the mean of k bilinear blends of four depth tests, whole texels apart",
+          "[gi][lamp]") {
+    // shaders/common/shadow.glsl gathers each 2×2's four tests and blends their sums
+    // once. Here the filter as the GL spec defines a comparison sampler's bilinear
+    // lookup (LEQUAL against each of the four nearest texels, clamped to the edge,
+    // weighted by the position between their centres), computed on the CPU from the
+    // map's depths, lookup by lookup: within 1e-4 (float weights; a gather's tests in
+    // the wrong places, or weights from the wrong corner, are off by tenths at the
+    // random map's edges).
+    REQUIRE(test::ensureHeadlessContext());
+    const int side = 16;
+    std::vector<float> depths(side * side);
+    uint32_t state = 12345u;
+    auto uniform = [&] { return float((state = state * 1664525u + 1013904223u) >> 8) / float(1u << 24); };
+    for (float& d : depths) d = 0.3f + 0.4f * uniform();
+    gl::Texture map = gl::Texture::create(GL_TEXTURE_2D, GL_DEPTH_COMPONENT32F, side, side, 1, 1, "shadow filter map");
+    glTextureSubImage2D(map.id(), 0, 0, 0, side, side, GL_DEPTH_COMPONENT, GL_FLOAT, depths.data());
+    gl::SamplerHandle sampler = gl::createSampler();  // composite's comparison sampler
+    glSamplerParameteri(sampler.id(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glSamplerParameteri(sampler.id(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glSamplerParameteri(sampler.id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glSamplerParameteri(sampler.id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glSamplerParameteri(sampler.id(), GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+    glSamplerParameteri(sampler.id(), GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+
+    // Points of the map (xy) and depths to test (z): across it, at its edges and
+    // corners, a third of a texel or more from any texel centre's line.
+    std::vector<glm::vec4> points;
+    for (int i = 0; i < 96; ++i) {
+        glm::vec2 uv((std::floor(uniform() * side * 3.0f) + 1.0f) / (3.0f * side) + 0.013f * uniform() / side,
+                     (std::floor(uniform() * side * 3.0f) + 1.0f) / (3.0f * side) + 0.013f * uniform() / side);
+        points.push_back({uv, 0.25f + 0.5f * uniform(), 1.0f});
+    }
+    for (glm::vec2 corner : {glm::vec2(0.01f, 0.02f), glm::vec2(0.99f, 0.01f), glm::vec2(0.02f, 0.985f), glm::vec2(0.98f, 0.99f)})
+        points.push_back({corner, 0.5f, 1.0f});
+    points.push_back({0.5f, 0.5f, 0.5f, 0.0f});  // outside the lamp's frustum: lit
+
+    auto texelTest = [&](int x, int y, float ref) {
+        x = std::clamp(x, 0, side - 1), y = std::clamp(y, 0, side - 1);
+        return ref <= depths[size_t(y * side + x)] ? 1.0 : 0.0;
+    };
+    auto bilinear = [&](glm::dvec2 uv, float ref) {
+        const glm::dvec2 t = uv * double(side) - 0.5, i = glm::floor(t), f = t - i;
+        const int x = int(i.x), y = int(i.y);
+        return (1 - f.y) * ((1 - f.x) * texelTest(x, y, ref) + f.x * texelTest(x + 1, y, ref)) +
+               f.y * ((1 - f.x) * texelTest(x, y + 1, ref) + f.x * texelTest(x + 1, y + 1, ref));
+    };
+
+    const std::filesystem::path dir = std::filesystem::path(TEST_OUTPUT_DIR) / "shadow_probe";
+    std::filesystem::create_directories(dir);
+    std::ofstream(dir / "probe.comp") << R"(#version 450 core
+#include "common/shadow.glsl"
+layout(local_size_x = 1) in;
+layout(binding = 4) uniform sampler2DShadow u_map;
+layout(std430, binding = 0) readonly buffer Points { vec4 points[]; };
+layout(std430, binding = 1) writeonly buffer Result { float lit[]; };
+void main() { lit[gl_GlobalInvocationID.x] = shadowFilteredAt(u_map, points[gl_GlobalInvocationID.x], 0.0); }
+)";
+    ShaderLibrary library({std::filesystem::path(KILN_SOURCE_DIR) / "shaders", dir});
+    for (int pcf : {1, 3, 5}) {
+        ProgramBuild build = buildProgram(library, {.stages = {"probe.comp"}, .defines = {{"KILN_PCF", std::to_string(pcf)}},
+                                                    .debugName = "shadow probe"});
+        INFO(build.errorText());
+        REQUIRE(build.ok());
+        gl::Buffer pointBuffer = gl::Buffer::create(GLsizeiptr(points.size() * sizeof(glm::vec4)), points.data(), 0, "points");
+        gl::Buffer resultBuffer = gl::Buffer::create(GLsizeiptr(points.size() * 4), nullptr, 0, "lit");
+        glUseProgram(build.program.id());
+        glBindTextureUnit(4, map.id());
+        glBindSampler(4, sampler.id());
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, pointBuffer.id());
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, resultBuffer.id());
+        glDispatchCompute(GLuint(points.size()), 1, 1);
+        glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+        std::vector<float> lit(points.size());
+        glGetNamedBufferSubData(resultBuffer.id(), 0, GLsizeiptr(lit.size() * 4), lit.data());
+        glBindSampler(4, 0);
+        glUseProgram(0);
+
+        const int n = (pcf + 1) / 2;
+        int partial = 0, wrong = 0;
+        double worst = 0.0;
+        for (size_t i = 0; i < points.size(); ++i) {
+            double expected = 1.0;
+            if (points[i].w != 0.0f) {
+                expected = 0.0;
+                for (int y = 0; y < n; ++y)
+                    for (int x = 0; x < n; ++x)
+                        expected += bilinear(glm::dvec2(points[i]) + (glm::dvec2(x, y) * 2.0 - double(n - 1)) / double(side),
+                                             points[i].z);
+                expected /= double(n * n);
+            }
+            partial += expected > 0.01 && expected < 0.99;
+            worst = std::max(worst, std::abs(lit[i] - expected));
+            wrong += std::abs(lit[i] - expected) > 1e-4;
+        }
+        INFO("pcf " << pcf << ": " << partial << " of " << points.size() << " points partly lit, worst " << worst);
+        CHECK(partial > int(points.size()) / 3);  // the random map's depths straddle the tests
+        CHECK(wrong == 0);
+    }
 }
 
 TEST_CASE("lamp: traced at one pixel in 4×4 and upsampled, the lamp's light stays within 2 % of per-pixel contours",
