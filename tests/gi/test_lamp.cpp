@@ -90,6 +90,22 @@ struct Probe {
     std::string what;
 };
 
+// Runs `program` (bound, with whatever else it reads) once per input, the inputs in
+// storage buffer 0 (`bytes` of them), one float out per invocation from buffer 1.
+std::vector<float> dispatchProbes(GLuint program, const void* inputs, size_t bytes, size_t count) {
+    gl::Buffer inputBuffer = gl::Buffer::create(GLsizeiptr(bytes), inputs, 0, "probe inputs");
+    gl::Buffer resultBuffer = gl::Buffer::create(GLsizeiptr(count * 4), nullptr, 0, "probe results");
+    glUseProgram(program);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, inputBuffer.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, resultBuffer.id());
+    glDispatchCompute(GLuint(count), 1, 1);
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    std::vector<float> result(count);
+    glGetNamedBufferSubData(resultBuffer.id(), 0, GLsizeiptr(count * 4), result.data());
+    glUseProgram(0);
+    return result;
+}
+
 // Φ at each probe from shaders/common/light.glsl, KILN_LAMP_SAMPLES = vertices;
 // `expression` (of p and n) replaces the irradiance ÷ radiance of lampLight.
 std::vector<double> projectedSolidAngleByShader(const std::vector<Probe>& probes, int vertices, bool contour,
@@ -125,17 +141,8 @@ void main() {
         packed.insert(packed.end(), {float(probe.p.x), float(probe.p.y), float(probe.p.z), 0.0f, float(probe.n.x),
                                      float(probe.n.y), float(probe.n.z), 0.0f});
     gl::Buffer frameBuffer = gl::Buffer::create(GLsizeiptr(frame.size() * 4), frame.data(), 0, "lamp probe frame");
-    gl::Buffer probeBuffer = gl::Buffer::create(GLsizeiptr(packed.size() * 4), packed.data(), 0, "lamp probes");
-    gl::Buffer resultBuffer = gl::Buffer::create(GLsizeiptr(probes.size() * 4), nullptr, GL_DYNAMIC_STORAGE_BIT, "lamp result");
-    glUseProgram(build.program.id());
     glBindBufferBase(GL_UNIFORM_BUFFER, 0, frameBuffer.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, probeBuffer.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, resultBuffer.id());
-    glDispatchCompute(GLuint(probes.size()), 1, 1);
-    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-    std::vector<float> result(probes.size());
-    glGetNamedBufferSubData(resultBuffer.id(), 0, GLsizeiptr(result.size() * 4), result.data());
-    glUseProgram(0);
+    const std::vector<float> result = dispatchProbes(build.program.id(), packed.data(), packed.size() * 4, probes.size());
     return {result.begin(), result.end()};
 }
 
@@ -389,19 +396,11 @@ void main() { lit[gl_GlobalInvocationID.x] = shadowFilteredAt(u_map, points[gl_G
                                                     .debugName = "shadow probe"});
         INFO(build.errorText());
         REQUIRE(build.ok());
-        gl::Buffer pointBuffer = gl::Buffer::create(GLsizeiptr(points.size() * sizeof(glm::vec4)), points.data(), 0, "points");
-        gl::Buffer resultBuffer = gl::Buffer::create(GLsizeiptr(points.size() * 4), nullptr, 0, "lit");
-        glUseProgram(build.program.id());
         glBindTextureUnit(4, map.id());
         glBindSampler(4, sampler.id());
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, pointBuffer.id());
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, resultBuffer.id());
-        glDispatchCompute(GLuint(points.size()), 1, 1);
-        glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-        std::vector<float> lit(points.size());
-        glGetNamedBufferSubData(resultBuffer.id(), 0, GLsizeiptr(lit.size() * 4), lit.data());
+        const std::vector<float> lit =
+            dispatchProbes(build.program.id(), points.data(), points.size() * sizeof(glm::vec4), points.size());
         glBindSampler(4, 0);
-        glUseProgram(0);
 
         const int n = (pcf + 1) / 2;
         int partial = 0, wrong = 0;
