@@ -341,8 +341,8 @@ void reportGrowth(const Args& args, const std::vector<Config>& configs, std::vec
         << ",particles,frame_ms,ratio,voxelize_ms,gbuffer_ms,shadow_ms,paired_ratio,paired_min,paired_max\n";
     std::printf("growth: frame cost against %s (ratio to the first count of the same pipeline; paired: the median, "
                 "lowest and highest of each round's ratio)\n", args.growKind.c_str());
-    std::printf("  %-10s %9s %10s %9s %7s %11s %10s %9s  %s\n", "pipeline", args.growKind.c_str(), "particles", "frame ms",
-                "ratio", "voxelize ms", "gbuffer ms", "shadow ms", "paired (min-max)");
+    std::printf("  %-10s %9s %10s %9s %7s %11s %10s %9s  %s\n", "pipeline", args.growKind.c_str(), "particles",
+                "frame ms", "ratio", "voxelize ms", "gbuffer ms", "shadow ms", "paired (min-max)");
     std::map<std::string, size_t> base;  // the pipeline's first count's index
     for (size_t i = 0; i < configs.size(); ++i) {
         const std::string pipeline = fs::path(configs[i].pipeline).stem().string();
@@ -351,7 +351,8 @@ void reportGrowth(const Args& args, const std::vector<Config>& configs, std::vec
         const Measured& b = measured[base[pipeline]];
         const double frame = median(m.frameMs), ratio = frame / median(b.frameMs);
         std::vector<double> rounds;  // frameMs holds one median a round, in the rounds' order
-        for (size_t r = 0; r < m.frameMs.size() && r < b.frameMs.size(); ++r) rounds.push_back(m.frameMs[r] / b.frameMs[r]);
+        for (size_t r = 0; r < m.frameMs.size() && r < b.frameMs.size(); ++r)
+            rounds.push_back(m.frameMs[r] / b.frameMs[r]);
         if (rounds.empty()) rounds.push_back(ratio);
         const double paired = median(rounds);
         const auto [low, high] = std::minmax_element(rounds.begin(), rounds.end());

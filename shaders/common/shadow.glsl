@@ -75,7 +75,7 @@ float shadowFilteredAt(sampler2DShadow shadowMap, vec4 ls, float bias) {
     const int n = (KILN_PCF + 1) / 2;
     vec2 size = vec2(textureSize(shadowMap, 0));
     vec2 texel = 1.0 / size;
-    vec4 sum = vec4(0.0);  // the tests by their place in each 2×2, in gather's order: (0,1) (1,1) (1,0) (0,0)
+    vec4 sum = vec4(0.0);  // the tests by place in each 2×2, gather's order: (0,1) (1,1) (1,0) (0,0)
     for (int y = 0; y < n; ++y)
         for (int x = 0; x < n; ++x) {
             vec2 offset = (vec2(x, y) * 2.0 - float(n - 1)) * texel;
@@ -86,4 +86,6 @@ float shadowFilteredAt(sampler2DShadow shadowMap, vec4 ls, float bias) {
     return ls.w == 0.0 ? 1.0 : lit / float(n * n);
 }
 
-float shadowFiltered(sampler2DShadow shadowMap, vec3 p, float bias) { return shadowFilteredAt(shadowMap, lightSpace(p), bias); }
+float shadowFiltered(sampler2DShadow shadowMap, vec3 p, float bias) {
+    return shadowFilteredAt(shadowMap, lightSpace(p), bias);
+}

@@ -142,7 +142,8 @@ void main() {
                                      float(probe.n.y), float(probe.n.z), 0.0f});
     gl::Buffer frameBuffer = gl::Buffer::create(GLsizeiptr(frame.size() * 4), frame.data(), 0, "lamp probe frame");
     glBindBufferBase(GL_UNIFORM_BUFFER, 0, frameBuffer.id());
-    const std::vector<float> result = dispatchProbes(build.program.id(), packed.data(), packed.size() * 4, probes.size());
+    const std::vector<float> result =
+        dispatchProbes(build.program.id(), packed.data(), packed.size() * 4, probes.size());
     return {result.begin(), result.end()};
 }
 
@@ -358,14 +359,16 @@ TEST_CASE("lamp: the shadow filter is the mean of k bilinear blends of four dept
     glSamplerParameteri(sampler.id(), GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
 
     // Points of the map (xy) and depths to test (z): across it, at its edges and
-    // corners, a third of a texel or more from any texel centre's line.
+    // corners, at thirds of a texel (a sixth or more from any line through texel
+    // centres, where the texels a lookup blends change).
     std::vector<glm::vec4> points;
     for (int i = 0; i < 96; ++i) {
         glm::vec2 uv((std::floor(uniform() * side * 3.0f) + 1.0f) / (3.0f * side) + 0.013f * uniform() / side,
                      (std::floor(uniform() * side * 3.0f) + 1.0f) / (3.0f * side) + 0.013f * uniform() / side);
         points.push_back({uv, 0.25f + 0.5f * uniform(), 1.0f});
     }
-    for (glm::vec2 corner : {glm::vec2(0.01f, 0.02f), glm::vec2(0.99f, 0.01f), glm::vec2(0.02f, 0.985f), glm::vec2(0.98f, 0.99f)})
+    for (glm::vec2 corner :
+         {glm::vec2(0.01f, 0.02f), glm::vec2(0.99f, 0.01f), glm::vec2(0.02f, 0.985f), glm::vec2(0.98f, 0.99f)})
         points.push_back({corner, 0.5f, 1.0f});
     points.push_back({0.5f, 0.5f, 0.5f, 0.0f});  // outside the lamp's frustum: lit
 
@@ -392,7 +395,8 @@ void main() { lit[gl_GlobalInvocationID.x] = shadowFilteredAt(u_map, points[gl_G
 )";
     ShaderLibrary library({std::filesystem::path(KILN_SOURCE_DIR) / "shaders", dir});
     for (int pcf : {1, 3, 5}) {
-        ProgramBuild build = buildProgram(library, {.stages = {"probe.comp"}, .defines = {{"KILN_PCF", std::to_string(pcf)}},
+        ProgramBuild build = buildProgram(library, {.stages = {"probe.comp"},
+                                                    .defines = {{"KILN_PCF", std::to_string(pcf)}},
                                                     .debugName = "shadow probe"});
         INFO(build.errorText());
         REQUIRE(build.ok());
@@ -410,9 +414,10 @@ void main() { lit[gl_GlobalInvocationID.x] = shadowFilteredAt(u_map, points[gl_G
             if (points[i].w != 0.0f) {
                 expected = 0.0;
                 for (int y = 0; y < n; ++y)
-                    for (int x = 0; x < n; ++x)
-                        expected += bilinear(glm::dvec2(points[i]) + (glm::dvec2(x, y) * 2.0 - double(n - 1)) / double(side),
-                                             points[i].z);
+                    for (int x = 0; x < n; ++x) {
+                        const glm::dvec2 offset = (glm::dvec2(x, y) * 2.0 - double(n - 1)) / double(side);
+                        expected += bilinear(glm::dvec2(points[i]) + offset, points[i].z);
+                    }
                 expected /= double(n * n);
             }
             partial += expected > 0.01 && expected < 0.99;

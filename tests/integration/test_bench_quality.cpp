@@ -142,8 +142,8 @@ TEST_CASE("kiln-bench-render --grow: one growth row per count, the first the bas
     std::istringstream csv(slurp(out + "/growth.csv"));
     std::string line;
     std::getline(csv, line);
-    CHECK(line == "pipeline,fireballs,particles,frame_ms,ratio,voxelize_ms,gbuffer_ms,shadow_ms,paired_ratio,paired_min,"
-                  "paired_max");
+    CHECK(line == "pipeline,fireballs,particles,frame_ms,ratio,voxelize_ms,gbuffer_ms,shadow_ms,"
+                  "paired_ratio,paired_min,paired_max");
     std::vector<std::vector<double>> rows;
     while (std::getline(csv, line)) {
         std::istringstream cells(line.substr(line.find(',') + 1));
