@@ -391,7 +391,7 @@ TEST_CASE("bloom's bright-pass is the part above the threshold of each 2x2 block
     REQUIRE(rig.app.runtime().loadPipelineText(bloomPipeline(threshold), "bloom.json", errors));
     rig.app.paused = false;
     std::vector<char> wasBright;
-    int darkened = 0;  // texels bright at some frame and dark at a later one
+    int darkened = 0;  // texel-frames: a texel dark at a frame after one where it was bright
     for (int frame = 0; frame < 8; ++frame) {
         rig.app.frame();
         const FloatImage emission = test::readOutput(rig.app, "gbuffer", "emissive");
@@ -421,7 +421,7 @@ TEST_CASE("bloom's bright-pass is the part above the threshold of each 2x2 block
         CHECK(passing < bright.width * bright.height / 2);
         CHECK(wrong == 0);
     }
-    INFO(darkened << " texels went dark after being bright");
+    INFO(darkened << " texel-frames dark after being bright");
     CHECK(darkened > 0);  // the moving scene exercised it
 }
 
