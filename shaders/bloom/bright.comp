@@ -10,10 +10,15 @@
 // seven of a 64-wide tree cost more than the whole bright-pass (measured). Five atomics
 // from every bright texel cost it 1.3 ms at 720² with 50 fireballs' sparks on screen
 // (two threads contending for one cache line): each is taken only where it would change
-// the value, which after the first few texels is almost never (2.7 -> 1.4 ms). Only the
-// bright texels are stored, over the rectangle bloom.cpp cleared (llvmpipe skips a
-// masked lane's store): the bright-pass 1.6 -> 1.3 ms with the default's two fireballs.
-// Drawn as a fragment shader instead, the pass cost more.
+// the value, which after the first few texels is almost never (2.7 -> 1.4 ms).
+// KILN_BRIGHT_SPARSE 1: only the bright texels are stored, over the rectangle bloom.cpp
+// cleared (llvmpipe skips a masked lane's store): the bright-pass 1.6 -> 1.3 ms with the
+// default's two fireballs. 0: every texel is stored, dark ones black, and nothing is
+// cleared (on a GPU the cleared texture cost more than the stores: bloom.cpp's
+// bright_stores). Drawn as a fragment shader instead, the pass cost more.
+#ifndef KILN_BRIGHT_SPARSE
+#define KILN_BRIGHT_SPARSE 1
+#endif
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(binding = 0) uniform sampler2D u_color;
 layout(binding = 0, rgba16f) uniform writeonly image2D u_bright;
@@ -29,7 +34,12 @@ void main() {
     if (any(greaterThanEqual(q, imageSize(u_bright)))) return;
     vec3 c = textureLod(u_color, vec2(2 * q + 1) / vec2(size), 0.0).rgb;
     float l = dot(c, vec3(0.2126, 0.7152, 0.0722));
-    if (!(l > u_threshold)) return;  // NaN is not bright either; bloom.cpp cleared the texel
+    if (!(l > u_threshold)) {  // NaN is not bright either
+#if !KILN_BRIGHT_SPARSE
+        imageStore(u_bright, q, vec4(0.0, 0.0, 0.0, 1.0));
+#endif
+        return;  // sparse: bloom.cpp cleared the texel
+    }
     imageStore(u_bright, q, vec4(c * ((l - u_threshold) / l), 1.0));
     // Each atomic only where it would change the value: they only ever grow the
     // rectangle, so a stale read errs towards taking one, never past it.

@@ -348,11 +348,11 @@ float maxLuminance(app::App& app, const char* pass, const char* name) {
         }
     return m;
 }
-std::string bloomPipeline(float threshold) {
+std::string bloomPipeline(float threshold, const std::string& brightStores = "auto") {
     return R"({"output": "bloom.bloom", "passes": [
         {"id": "gbuffer", "module": "gbuffer"},
         {"id": "bloom", "module": "bloom", "inputs": {"color": "gbuffer.emissive"},
-         "params": {"threshold": )" + std::to_string(threshold) + "}}]}";
+         "params": {"threshold": )" + std::to_string(threshold) + R"(, "bright_stores": ")" + brightStores + "\"}}]}";
 }
 }  // namespace
 
@@ -382,13 +382,16 @@ TEST_CASE("bloom's bright-pass is the part above the threshold of each 2x2 block
     // above the threshold, c (l − t) / l. Checked against the same done here on the
     // CPU from gbuffer.emissive: equal within RGBA16F's rounding (1e-3 relative: the
     // lookup's filter weights are exact at the centre, the result is stored in halves).
-    // Frame after frame with the scene moving: the pass stores only the bright texels,
-    // over a rectangle it cleared, so a texel left bright from an earlier frame would
-    // show here (one frame alone could not: a fresh texture starts black).
+    // Frame after frame with the scene moving, both ways the pass can leave a dark texel
+    // black (bright_stores: the texture cleared and only the bright texels stored, or
+    // every texel stored), so a texel left bright from an earlier frame would show here
+    // (one frame alone could not: a fresh texture starts black).
+    const std::string stores = GENERATE(std::string("sparse"), std::string("dense"));
+    INFO("bright_stores " << stores);
     Rig rig({}, 192);
     std::string errors;
     const float threshold = 1.0f;
-    REQUIRE(rig.app.runtime().loadPipelineText(bloomPipeline(threshold), "bloom.json", errors));
+    REQUIRE(rig.app.runtime().loadPipelineText(bloomPipeline(threshold, stores), "bloom.json", errors));
     rig.app.paused = false;
     std::vector<char> wasBright;
     int darkened = 0;  // texel-frames: a texel dark at a frame after one where it was bright
