@@ -105,7 +105,9 @@ SceneView App::buildView() {
     const glm::mat4 view = camera_.view();
     const glm::mat4 proj = camera_.projection(float(options_.width) / float(options_.height));
     scene_.writeTo(renderer_, scene_.sim().dragged());
-    renderer_.setViewer(camera_.position(), proj[1][1] * 0.5f * float(options_.height));
+    // The view's forward axis in the world: minus the view matrix's third row.
+    const glm::vec3 forward = -glm::vec3(view[0][2], view[1][2], view[2][2]);
+    renderer_.setViewer(camera_.position(), forward, proj[1][1] * 0.5f * float(options_.height));
     renderer_.upload();
 
     SceneView v;

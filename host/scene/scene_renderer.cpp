@@ -146,11 +146,12 @@ void SceneRenderer::setParticles(const std::vector<ParticleInstance>& particles)
     dirty_ = true;
 }
 
-void SceneRenderer::setViewer(glm::vec3 eye, float pixelsPerUnit) {
-    if (eye == eye_ && pixelsPerUnit == pixelsPerUnit_) return;
+void SceneRenderer::setViewer(glm::vec3 eye, glm::vec3 forward, float pixelsPerUnit) {
+    if (eye == eye_ && forward == forward_ && pixelsPerUnit == pixelsPerUnit_) return;
     eye_ = eye;
+    forward_ = forward;
     pixelsPerUnit_ = pixelsPerUnit;
-    dirty_ = true;  // the spheres' levels follow the camera (their contents do not)
+    dirty_ = true;  // the spheres' levels and the particles' order follow the camera (their contents do not)
 }
 
 // At a third of the triangles for the usual 20–40-px marble (measured: 100 marbles at
@@ -233,7 +234,15 @@ void SceneRenderer::upload() {
     all.reserve(staticInstances_.size() + bodyInstances_.size() + particleInstances_.size());
     all.insert(all.end(), staticInstances_.begin(), staticInstances_.end());
     all.insert(all.end(), bodyInstances_.begin(), bodyInstances_.end());
-    all.insert(all.end(), particleInstances_.begin(), particleInstances_.end());
+    // The particles far to near along the view: the G-buffer draws them without writing
+    // depth (passes/gbuffer), so where two cover a pixel the nearer must come last, as
+    // a depth test against their centres' depths would have it.
+    particleOrder_.resize(particleInstances_.size());
+    for (size_t i = 0; i < particleInstances_.size(); ++i)
+        particleOrder_[i] = {glm::dot(glm::vec3(particleInstances_[i].model[3]) - eye_, forward_), uint32_t(i)};
+    std::stable_sort(particleOrder_.begin(), particleOrder_.end(),
+                     [](const auto& a, const auto& b) { return a.first > b.first; });
+    for (const auto& [depth, i] : particleOrder_) all.push_back(particleInstances_[i]);
     if (all.size() > instanceCapacity_) {
         instanceCapacity_ = std::max<size_t>(all.size() * 2, 256);
         instanceBuffer_ = gl::Buffer::create(static_cast<GLsizeiptr>(instanceCapacity_ * sizeof(GpuInstance)), nullptr,

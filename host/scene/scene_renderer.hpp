@@ -91,9 +91,10 @@ public:
     void setLook(const SceneLook&);
     void setBodies(const std::vector<BodyInstance>&);
     void setParticles(const std::vector<ParticleInstance>&);
-    // The camera, for the spheres' level of detail: its position and the pixels a unit
-    // length spans at unit distance (projection[1][1] × height / 2).
-    void setViewer(glm::vec3 eye, float pixelsPerUnit);
+    // The camera, for the spheres' level of detail and the particles' order: its
+    // position, the unit vector it looks along, and the pixels a unit length spans at
+    // unit distance (projection[1][1] × height / 2).
+    void setViewer(glm::vec3 eye, glm::vec3 forward, float pixelsPerUnit);
     // Uploads what changed; call once per frame before the passes run.
     void upload();
     // Instanced draws of every group matching the filter with the current program.
@@ -136,8 +137,9 @@ private:
     size_t instanceCapacity_ = 0;
     std::vector<GpuInstance> staticInstances_, bodyInstances_, particleInstances_;
     std::vector<Group> groups_;
-    glm::vec3 eye_{0.0f};
+    glm::vec3 eye_{0.0f}, forward_{0.0f, 0.0f, -1.0f};
     float pixelsPerUnit_ = 0.0f;
+    std::vector<std::pair<float, uint32_t>> particleOrder_;  // upload()'s scratch: depth, index
     std::array<std::array<uint32_t, 3>, 2> sphereLevels_{};  // marbles, fireballs: near, mid, far
     bool tumblersNear_ = true;  // the camera's tumblers at their near mesh
     bool dirty_ = true;

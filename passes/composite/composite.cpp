@@ -43,7 +43,8 @@ public:
         d.input({.name = "albedo", .doc = "output-sized"})
             .input({.name = "normal", .doc = "output-sized"})
             .input({.name = "depth", .kind = TextureKind::Depth2D, .doc = "output-sized"})
-            .input({.name = "emissive", .required = false, .fallback = Fallback::Black, .doc = "output-sized"})
+            .input({.name = "emissive", .required = false, .fallback = Fallback::Black,
+                    .doc = "output-sized; alpha 2: a particle hides the surface, its emission alone shows"})
             .input({.name = "shadow_map", .kind = TextureKind::Depth2D, .required = false})
             .input({.name = "indirect", .required = false, .fallback = Fallback::Black})
             .input({.name = "bloom", .required = false, .fallback = Fallback::Black})
@@ -272,8 +273,8 @@ private:
         k.textures[5] = lampField_.id();
         k.programs = {program, nearProgram};
         std::copy(std::begin(ctx.scene().counts), std::end(ctx.scene().counts), k.counts.begin());
-        // The particles come and go at the end of the instances: moved_tiles.comp marks
-        // where those that went were and those that came are.
+        // The particles change none of the G-buffer the kept light comes from (gbuffer
+        // writes only their emission), nor do they cast shadows.
         k.counts[size_t(kiln::sceneCategoryIndex(kiln::kSceneParticles))] = 0;
         k.shadowBias = ctx.getFloat("shadow_bias");
         k.nearField = ctx.getFloat("lamp_near_field");
@@ -285,8 +286,7 @@ private:
     // light recomputed and kept over those, the rest shaded from what was kept. When
     // most of the picture moved at the last count, drawing it in tiles costs more than
     // the whole (llvmpipe, 720²: all tiles recomputed 22 ms, the plain pass 20; 50
-    // fireballs' particles move over 80 % of the tiles): DrawWhole, and the tiles are
-    // only counted.
+    // fireballs move 65 % of the tiles): DrawWhole, and the tiles are only counted.
     enum class Kept { Drawn, DrawWhole, Failed };
     Kept drawKeepingDirect(kiln::PassContext& ctx, GLuint program, GLuint nearProgram, GLuint cachedProgram,
                            const kiln::PixelRect& nearRect) {
@@ -303,7 +303,8 @@ private:
         const int tilesAcross = (color.width + tileSize - 1) / tileSize;
         const int tilesDown = (color.height + tileSize - 1) / tileSize;
         const uint32_t tileCount = uint32_t(tilesAcross * tilesDown);
-        const uint32_t first = scene.firstInstance(kiln::kSceneTumblers), end = scene.count(kiln::kSceneGeometry);
+        // The particles, last in the instances, are not followed (cacheKey).
+        const uint32_t first = scene.firstInstance(kiln::kSceneTumblers), end = scene.firstInstance(kiln::kSceneParticles);
 
         // The share of the tiles that moved at the last count the GPU has finished.
         if (countFence_ && glClientWaitSync(countFence_, 0, 0) != GL_TIMEOUT_EXPIRED) {
@@ -315,9 +316,8 @@ private:
         }
         // No instance moved since the last run (the scene paused or asleep): none of
         // the tiles would be marked.
-        const std::array<uint64_t, 4> instances{scene.version(kiln::kSceneTumblers), scene.version(kiln::kSceneMarbles),
-                                                scene.version(kiln::kSceneFireballs),
-                                                scene.version(kiln::kSceneParticles)};
+        const std::array<uint64_t, 3> instances{scene.version(kiln::kSceneTumblers), scene.version(kiln::kSceneMarbles),
+                                                scene.version(kiln::kSceneFireballs)};
         if (instances == instancesSeen_) movedShare_ = 0.0;
         instancesSeen_ = instances;
         // Back from the whole at a lower share than away to it: the first run in tiles
@@ -326,8 +326,8 @@ private:
         drawingWhole_ = !inTiles;
         // Drawing whole, the tiles are only counted, to know when to come back to them:
         // every kCountWholeEvery-th run, the run before it keeping the instances to
-        // compare with (marking 50 fireballs' 4 000 particles each run cost composite
-        // 1 ms at 720², for nothing drawn).
+        // compare with (marking 50 fireballs' 4 000 particles each run, when they were
+        // followed, cost composite 1 ms at 720² for nothing drawn).
         bool keepOnly = false;
         if (!inTiles) {
             const uint32_t phase = wholeRuns_++ % kCountWholeEvery;
@@ -506,7 +506,7 @@ private:
     static constexpr uint32_t kCountWholeEvery = 8;
     bool drawingWhole_ = false;
     uint32_t wholeRuns_ = 0;                // runs drawn whole in a row
-    std::array<uint64_t, 4> instancesSeen_{};  // the moving categories' versions at the last run
+    std::array<uint64_t, 3> instancesSeen_{};  // the followed categories' versions at the last run
     std::optional<CacheKey> cacheKey_;      // what the kept light was computed from; empty: nothing kept
     kiln::gl::Buffer previous_;             // the instances at the last run
     uint32_t previousEnd_ = 0;              // how many there were

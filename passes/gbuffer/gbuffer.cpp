@@ -1,7 +1,7 @@
 // gbuffer — draws every mesh of the scene into albedo, world-space normal, emitted
 // radiance and depth, the marbles and fireballs as spheres traced over their screen
-// rectangles, the particles as point sprites shaded as spheres. The first pass of
-// every pipeline.
+// rectangles, the particles as point sprites over them, into the emission only. The
+// first pass of every pipeline.
 #include <kiln/pass.hpp>
 
 namespace {
@@ -13,7 +13,9 @@ public:
         PassDeclaration d;
         d.output({.name = "albedo", .format = Format::RGBA8, .doc = "linear albedo"})
             .output({.name = "normal", .format = Format::RGBA16F, .doc = "world-space unit normal; w = 1 on geometry"})
-            .output({.name = "emissive", .format = Format::RGBA16F, .doc = "emitted radiance"})
+            .output({.name = "emissive", .format = Format::RGBA16F,
+                     .doc = "emitted radiance; a = 1 on geometry, 2 where a particle hides the surface the other "
+                            "outputs hold (it writes only this), 0 elsewhere"})
             .output({.name = "depth", .kind = TextureKind::Depth2D, .format = Format::Depth32F,
                      .depthNear = kCameraNear, .depthFar = kCameraFar})
             .internal({.name = "wood", .format = Format::RGBA8, .size = SizeRule::fixed(1024, 1024),
@@ -38,12 +40,17 @@ public:
         const bool particles = ctx.getBool("particles");
         const bool points = particles && ctx.getEnum("particle_mode") == "points";
         GLuint pointProgram = points ? ctx.program({.stages = {"gbuffer/particle.vert", "gbuffer/particle.frag"}}) : 0;
+        GLuint particleMeshProgram =
+            particles && !points ? ctx.program({.stages = {"gbuffer/gbuffer.vert", "gbuffer/gbuffer.frag"},
+                                                .defines = {{"KILN_WOOD", "0"}, {"KILN_PARTICLE", "1"}}})
+                                 : 0;
         const bool tracedSpheres = ctx.getEnum("sphere_mode") == "traced";
         GLuint sphereProgram =
             tracedSpheres ? ctx.program({.stages = {"gbuffer/sphere.vert", "gbuffer/sphere.frag"}}) : 0;
         GLuint bake = ctx.program({.stages = {"gbuffer/wood.comp"}});
         GLuint background = ctx.program({.stages = {"gbuffer/background.vert", "gbuffer/background.frag"}});
         if (!program || !woodProgram || !bake || !background || (points && !pointProgram) ||
+            (particles && !points && !particleMeshProgram) ||
             (tracedSpheres && !sphereProgram))
             return;
         // The floor's grain, baked: sampled through its mips it is the grain averaged
@@ -73,16 +80,12 @@ public:
             glEnable(GL_DEPTH_TEST);
             glDepthFunc(GL_LESS);
             glUseProgram(program);
-            kiln::DrawFilter filter;
-            filter.categories = kiln::kSceneGeometry;
-            if (!particles || points) filter.categories &= ~kiln::kSceneParticles;
             // The bodies are closed, so their back faces never show: culled, they cost
             // llvmpipe no setup (13.3 against 16.4 ms at 720²), and no back face wins a
             // depth tie at a silhouette (3 pixels of 360² did). The walls and the lamp's dome
             // are open surfaces, seen from either side. The bodies first: they stand in
             // front of the walls, whose hidden fragments the depth test then rejects
             // before shading (gbuffer 5.36 -> 5.21 ms at 720², three alternations).
-            filter.categories &= ~kiln::kSceneBodies;
             glEnable(GL_CULL_FACE);
             glCullFace(GL_BACK);
             ctx.drawScene({.categories = tracedSpheres ? kiln::kSceneTumblers : kiln::kSceneBodies});
@@ -91,33 +94,54 @@ public:
                 drawTracedSpheres(ctx, sphereProgram);
                 glUseProgram(program);
             }
-            ctx.drawScene(filter);
+            ctx.drawScene({.categories = kiln::kSceneStatic});
             // The floor, the one wood-grained instance (a wall of the box).
             glUseProgram(woodProgram);
             kiln::gl::bindTexture(woodProgram, "u_wood", wood.id);
             ctx.drawScene({.categories = kiln::kSceneBox});
 
-            // Thousands of particles a few pixels wide: one point each, not 8 triangles
-            // (4 000 octahedra cost the G-buffer 15 ms at 720² on llvmpipe).
-            const uint32_t count = ctx.scene().count(kiln::kSceneParticles);
-            if (points && count > 0) {
-                glUseProgram(pointProgram);
-                glUniform1ui(glGetUniformLocation(pointProgram, "u_first"),
-                             ctx.scene().firstInstance(kiln::kSceneParticles));
-                glEnable(GL_PROGRAM_POINT_SIZE);
-                glBindVertexArray(emptyVertexArray());
-                glDrawArrays(GL_POINTS, 0, GLsizei(count));
-                glBindVertexArray(0);
-                glDisable(GL_PROGRAM_POINT_SIZE);
-            }
             glUseProgram(background);
             glDepthMask(GL_FALSE);
             ctx.drawFullscreenTriangle();
+            if (particles) drawParticles(ctx, points ? pointProgram : particleMeshProgram, points);
             glDepthMask(GL_TRUE);
         });
     }
 
 private:
+    // The particles, last, over the surfaces and the background: depth tested, but
+    // only their emission written, its alpha 2 (the `emissive` output's doc). Albedo,
+    // normal and depth stay those of the surface behind, so a particle moving over it
+    // changes none of what composite keeps of its lamp light: composite's kept tiles
+    // need not follow the particles (4 000 sparks with 50 fireballs moved 80 % of them),
+    // and cone_trace gathers for the surface, not for a spark a few pixels wide. One
+    // particle over another: the one drawn later shows.
+    void drawParticles(kiln::PassContext& ctx, GLuint program, bool points) {
+        const uint32_t count = ctx.scene().count(kiln::kSceneParticles);
+        if (count == 0) return;
+        glColorMaski(0, GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+        glColorMaski(1, GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+        glDepthMask(GL_FALSE);
+        glUseProgram(program);
+        if (points) {
+            // Thousands of particles a few pixels wide: one point each, not 8 triangles
+            // (4 000 octahedra cost the G-buffer 15 ms at 720² on llvmpipe).
+            glUniform1ui(glGetUniformLocation(program, "u_first"), ctx.scene().firstInstance(kiln::kSceneParticles));
+            glEnable(GL_PROGRAM_POINT_SIZE);
+            glBindVertexArray(emptyVertexArray());
+            glDrawArrays(GL_POINTS, 0, GLsizei(count));
+            glBindVertexArray(0);
+            glDisable(GL_PROGRAM_POINT_SIZE);
+        } else {
+            glEnable(GL_CULL_FACE);
+            glCullFace(GL_BACK);
+            ctx.drawScene({.categories = kiln::kSceneParticles});
+            glDisable(GL_CULL_FACE);
+        }
+        glColorMaski(0, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+        glColorMaski(1, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    }
+
     // sphere_mode traced: the marbles and the fireballs (neighbours in the instance
     // buffer, which holds the categories in bit order), each its screen rectangle.
     void drawTracedSpheres(kiln::PassContext& ctx, GLuint sphereProgram) {

@@ -166,7 +166,10 @@ vec3 lampDirect(ivec2 px, vec2 uv, vec4 n4, vec3 albedo) {
 
 // The pixel's radiance from its lamp light (lampDirect): dimmed by the fire, plus the
 // fireballs' light, albedo × the indirect light, and its emission. Where no geometry is
-// the albedo and the lamp light are 0 (gbuffer's background): emission only.
+// the albedo and the lamp light are 0 (gbuffer's background): emission only. Where a
+// particle hides the surface (emission's alpha 2; the G-buffer's other outputs are the
+// surface's, so the lamp light kept for it stays good when the particle moves on) the
+// particle's emission only: it has no albedo.
 vec3 shade(ivec2 px, vec2 uv, vec3 lampLit, vec3 albedo) {
     vec4 indirectLight = texture(u_indirect, uv);
     vec3 direct = lampLit;
@@ -185,7 +188,8 @@ vec3 shade(ivec2 px, vec2 uv, vec3 lampLit, vec3 albedo) {
     vec3 indirect = albedo * u_ambient;
 #endif
     // The optional emission may be the 1×1 fallback: clamped.
-    return direct + indirect + texelFetch(u_emissive, min(px, textureSize(u_emissive, 0) - 1), 0).rgb;
+    vec4 emission = texelFetch(u_emissive, min(px, textureSize(u_emissive, 0) - 1), 0);
+    return emission.a > 1.5 ? emission.rgb : direct + indirect + emission.rgb;
 }
 
 // The lamp light as `direct` keeps it (RGBA16F: an RGBA32F fetch cost llvmpipe 3.5 ms at

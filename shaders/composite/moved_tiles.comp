@@ -1,8 +1,9 @@
 #version 450 core
 // Marks the tiles of the picture whose lamp light (composite's `direct`) an instance
 // that changed since the pass's last run can have changed, and keeps this run's
-// instances for the next. One invocation per instance from the first tumbler (the
-// walls and the lamp changing redraw everything, composite.cpp).
+// instances for the next. One invocation per instance from the first tumbler to the
+// last fireball (the walls and the lamp changing redraw everything, composite.cpp; the
+// particles write only their emission, which composite does not keep).
 // An instance changes the G-buffer inside its box's screen rectangle, where it was and
 // where it is. A shadow caster also changes the shadow map inside its box's rectangle in
 // the map, and so the light of what lies in its shadow's pyramid (markShadow). A
@@ -60,7 +61,7 @@ void markWorldBox(vec3 lo, vec3 hi) {
     markPixels((clamp(a, -1.0, 1.0) * 0.5 + 0.5) * u_outputSize.xy, (clamp(b, -1.0, 1.0) * 0.5 + 0.5) * u_outputSize.xy);
 }
 
-// An instance's box: a sphere's (marbles, fireballs, particles: the unit sphere placed),
+// An instance's box: a sphere's (marbles, fireballs: the unit sphere placed),
 // or the tumbler's, its two balls' (its round cone is their convex hull: about its
 // origin, the lower ball of radius b and the upper of radius t at y_t), 5 % wider for
 // the mesh.
@@ -81,8 +82,8 @@ void instanceBox(KilnInstance inst, bool tumbler, out vec3 lo, out vec3 hi) {
 // caster's top down to the floor (nearer the lamp than the caster a depth test comes out
 // lit either way). The walls there: for each wall, the pyramid's part within 1 cm of
 // it, bounded by where its edges cross that slab and its corners inside it. The
-// instances there, wherever they are: each one's own box, but those of no albedo (the
-// particles: no lamp light to change), in a second dispatch (KILN_PART 2) against
+// instances there, wherever they are: each one's own box, but those of no albedo (a
+// burnt-out ball: no lamp light to change), in a second dispatch (KILN_PART 2) against
 // the pyramids' boxes this one records. The dome, if the pyramid reaches it.
 vec3 pyramid[8];  // corners: i & 3 the ray, i >> 2 top (0) or bottom (1)
 const ivec2 kPyramidEdges[12] = ivec2[](ivec2(0, 1), ivec2(1, 3), ivec2(3, 2), ivec2(2, 0), ivec2(4, 5), ivec2(5, 7),
@@ -163,7 +164,7 @@ void main() {
 #if KILN_PART == 2
     if (i < u_end) markIfShadowed(i);
 #else
-    bool now = i < u_end, before = i < u_previousEnd;  // the particles come and go at the end
+    bool now = i < u_end, before = i < u_previousEnd;  // fireballs come and go at the end
     if (i >= u_to || (!now && !before)) return;
     if (u_compare && !(now && before && sameInstance(kiln_instances[i], previous[i]))) {
         for (int k = 0; k < 2; ++k) {

@@ -5,7 +5,7 @@
 // 2×2 nearest samples with bilinear weights × how well each sample's surface matches
 // its own: normal agreement (cos⁸) and the pixel's distance from the sample's tangent
 // plane (the plane comes with the sample, so a tap is two fetches and no matrix).
-// None of the four matches (thin parts, small particles): the nearest sample, one of
+// None of the four matches (thin parts, a marble far off): the nearest sample, one of
 // the four.
 // No wider search for those few pixels: llvmpipe runs both sides of a divergent
 // branch under lane masks, so a fallback that almost never runs still costs every

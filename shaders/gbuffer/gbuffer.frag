@@ -12,7 +12,7 @@ flat in vec4 v_emissive;  // rgb radiance, a = highlight
 
 layout(location = 0) out vec4 o_albedo;
 layout(location = 1) out vec4 o_normal;    // xyz world-space unit normal, w = 1 where geometry
-layout(location = 2) out vec4 o_emissive;  // rgb radiance
+layout(location = 2) out vec4 o_emissive;  // rgb radiance, a = 1 (2: a particle, gbuffer.cpp)
 
 void main() {
 #if KILN_WOOD
@@ -25,5 +25,9 @@ void main() {
     vec3 emissive = emissionOf(v_emissive);
     o_albedo = vec4(albedo, 1.0);
     o_normal = vec4(n, 1.0);
+#if KILN_PARTICLE
+    o_emissive = vec4(emissive, 2.0);  // a particle's mesh: only this is written (gbuffer.cpp)
+#else
     o_emissive = vec4(emissive, 1.0);
+#endif
 }

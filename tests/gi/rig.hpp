@@ -9,6 +9,7 @@
 
 #include <catch2/catch.hpp>
 #include <glm/glm.hpp>
+#include <nlohmann/json.hpp>
 
 #include "app/app.hpp"
 #include "kiln/image_io.hpp"
@@ -84,6 +85,14 @@ inline glm::vec3 worldOf(Rig& rig, const FloatImage& depth, int x, int y) {
 
 inline std::string pipeline(const std::string& output, const std::string& passes) {
     return R"({"output": ")" + output + R"(", "passes": [)" + passes + "]}";
+}
+
+// pipelines/default.json with `params` set on its pass `id`.
+inline nlohmann::json defaultPipelineWith(const std::string& id, const nlohmann::json& params) {
+    nlohmann::json p = nlohmann::json::parse(std::ifstream(KILN_SOURCE_DIR "/pipelines/default.json"));
+    for (auto& pass : p["passes"])
+        if (pass["id"] == id) pass["params"].update(params);
+    return p;
 }
 
 }  // namespace kiln::test

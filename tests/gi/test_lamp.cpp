@@ -30,12 +30,7 @@ using namespace kiln;
 namespace {
 
 // The default pipeline with `params` set on its composite pass.
-nlohmann::json defaultWithComposite(const nlohmann::json& params) {
-    nlohmann::json p = nlohmann::json::parse(std::ifstream(KILN_SOURCE_DIR "/pipelines/default.json"));
-    for (auto& pass : p["passes"])
-        if (pass["id"] == "composite") pass["params"].update(params);
-    return p;
-}
+nlohmann::json defaultWithComposite(const nlohmann::json& params) { return test::defaultPipelineWith("composite", params); }
 
 // The shipped lamp (scenes/cornell.json): sphere (0, 1.1, 0), radius 0.35, below y = 1.
 const glm::dvec3 kLampCentre(0.0, 1.1, 0.0);

@@ -659,6 +659,45 @@ TEST_CASE("voxelize's tumbler mesh lies inside the round cone, by less than the 
     CHECK(inside > 0.25 * voxel);
 }
 
+TEST_CASE("scene renderer: the particles reach the instance buffer far to near along the view, re-sorted when the "
+          "camera turns",
+          "[scene][gl]") {
+    // The G-buffer draws the particles without writing depth (only their emission), in
+    // the buffer's order: where two cover a pixel the later shows, so the nearer must be
+    // later. Five particles along z, each with its own emission to tell it by, the eye
+    // on +z looking down -z, then on -z looking back: the order reverses with no change
+    // to the particles.
+    REQUIRE(test::ensureHeadlessContext());
+    scene::SceneRenderer renderer;
+    renderer.setLook(scene::SceneLook{});
+    renderer.setBodies({});
+    const float zs[] = {0.5f, -0.5f, 0.2f, -0.9f, 0.0f};
+    std::vector<scene::ParticleInstance> particles;
+    for (float z : zs) particles.push_back({glm::vec3(0.1f * z, 0.0f, z), 0.01f, glm::vec3(z + 1.0f, 0.0f, 0.0f)});
+    renderer.setParticles(particles);
+    auto uploadedZ = [&] {
+        renderer.upload();
+        renderer.bindInstances();
+        GLint buffer = 0;
+        glGetIntegeri_v(GL_SHADER_STORAGE_BUFFER_BINDING, GLuint(kInstanceBinding), &buffer);
+        const uint32_t first = renderer.count(kSceneBox) + renderer.count(kSceneLamp);
+        REQUIRE(renderer.count(kSceneParticles) == 5);
+        std::vector<GpuInstance> got(5);
+        glGetNamedBufferSubData(GLuint(buffer), GLintptr(first * sizeof(GpuInstance)), GLsizeiptr(5 * sizeof(GpuInstance)),
+                                got.data());
+        std::vector<float> z;
+        for (const GpuInstance& g : got) {
+            CHECK(g.emissive.r == g.model[3].z + 1.0f);  // each particle whole, its emission with it
+            z.push_back(g.model[3].z);
+        }
+        return z;
+    };
+    renderer.setViewer({0.0f, 0.0f, 3.0f}, {0.0f, 0.0f, -1.0f}, 500.0f);
+    CHECK(uploadedZ() == std::vector<float>{-0.9f, -0.5f, 0.0f, 0.2f, 0.5f});
+    renderer.setViewer({0.0f, 0.0f, -3.0f}, {0.0f, 0.0f, 1.0f}, 500.0f);
+    CHECK(uploadedZ() == std::vector<float>{0.5f, 0.2f, 0.0f, -0.5f, -0.9f});
+}
+
 TEST_CASE("tumbler level of detail: the camera takes the far mesh while every tumbler is small on screen",
           "[scene][gl]") {
     // Three upright tumblers 3 m from the viewer (a bounding radius of 0.41 m, so
@@ -684,20 +723,20 @@ TEST_CASE("tumbler level of detail: the camera takes the far mesh while every tu
                    shadowMesh = trianglesOf(scene::kTumblerShadow);
     REQUIRE(farMesh < nearMesh);
     auto drawn = [&](kiln::Lod lod) { return renderer.triangles({.categories = kSceneTumblers, .lod = lod}); };
-    const glm::vec3 eye(0.0f, 0.0f, 3.0f);
+    const glm::vec3 eye(0.0f, 0.0f, 3.0f), forward(0.0f, 0.0f, -1.0f);
     const float bounding = scene::tumblerBoundingRadius(look.tumblerB, look.tumblerT, look.tumblerAlpha);
     const float threshold = scene::kTumblerNearPx / bounding * 3.0f;  // pixels a unit at which one at 3 m is near
     renderer.setBodies(bodies);
-    renderer.setViewer(eye, 0.9f * threshold);
+    renderer.setViewer(eye, forward, 0.9f * threshold);
     renderer.upload();
     CHECK(drawn(kiln::Lod::High) == 3 * farMesh);
     CHECK(drawn(kiln::Lod::Fine) == 3 * nearMesh);
     CHECK(drawn(kiln::Lod::Medium) == 3 * shadowMesh);
-    renderer.setViewer(eye, 1.1f * threshold);
+    renderer.setViewer(eye, forward, 1.1f * threshold);
     renderer.upload();
     CHECK(drawn(kiln::Lod::High) == 3 * nearMesh);
     // Back to small, then one tumbler comes close: the largest decides for all.
-    renderer.setViewer(eye, 0.9f * threshold);
+    renderer.setViewer(eye, forward, 0.9f * threshold);
     renderer.upload();
     CHECK(drawn(kiln::Lod::High) == 3 * farMesh);
     bodies[1] = tumblerAt({0.0f, 0.0f, 2.0f});
