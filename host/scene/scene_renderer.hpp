@@ -139,7 +139,7 @@ private:
     std::vector<Group> groups_;
     glm::vec3 eye_{0.0f}, forward_{0.0f, 0.0f, -1.0f};
     float pixelsPerUnit_ = 0.0f;
-    std::vector<std::pair<float, uint32_t>> particleOrder_;  // upload()'s scratch: depth, index
+    std::vector<uint64_t> particleOrder_, sortScratch_;  // upload()'s: the particles' depths over their indices
     std::array<std::array<uint32_t, 3>, 2> sphereLevels_{};  // marbles, fireballs: near, mid, far
     bool tumblersNear_ = true;  // the camera's tumblers at their near mesh
     bool dirty_ = true;

@@ -664,14 +664,14 @@ TEST_CASE("scene renderer: the particles reach the instance buffer far to near a
           "[scene][gl]") {
     // The G-buffer draws the particles without writing depth (only their emission), in
     // the buffer's order: where two cover a pixel the later shows, so the nearer must be
-    // later. Five particles along z, each with its own emission to tell it by, the eye
-    // on +z looking down -z, then on -z looking back: the order reverses with no change
-    // to the particles.
+    // later. Six particles along z, each with its own emission to tell it by, the eye
+    // on +z looking down -z (one particle behind it: a negative depth, nearest of all),
+    // then on -z looking back: the order reverses with no change to the particles.
     REQUIRE(test::ensureHeadlessContext());
     scene::SceneRenderer renderer;
     renderer.setLook(scene::SceneLook{});
     renderer.setBodies({});
-    const float zs[] = {0.5f, -0.5f, 0.2f, -0.9f, 0.0f};
+    const float zs[] = {0.5f, -0.5f, 0.2f, -0.9f, 0.0f, 3.5f};
     std::vector<scene::ParticleInstance> particles;
     for (float z : zs) particles.push_back({glm::vec3(0.1f * z, 0.0f, z), 0.01f, glm::vec3(z + 1.0f, 0.0f, 0.0f)});
     renderer.setParticles(particles);
@@ -681,9 +681,9 @@ TEST_CASE("scene renderer: the particles reach the instance buffer far to near a
         GLint buffer = 0;
         glGetIntegeri_v(GL_SHADER_STORAGE_BUFFER_BINDING, GLuint(kInstanceBinding), &buffer);
         const uint32_t first = renderer.count(kSceneBox) + renderer.count(kSceneLamp);
-        REQUIRE(renderer.count(kSceneParticles) == 5);
-        std::vector<GpuInstance> got(5);
-        glGetNamedBufferSubData(GLuint(buffer), GLintptr(first * sizeof(GpuInstance)), GLsizeiptr(5 * sizeof(GpuInstance)),
+        REQUIRE(renderer.count(kSceneParticles) == 6);
+        std::vector<GpuInstance> got(6);
+        glGetNamedBufferSubData(GLuint(buffer), GLintptr(first * sizeof(GpuInstance)), GLsizeiptr(6 * sizeof(GpuInstance)),
                                 got.data());
         std::vector<float> z;
         for (const GpuInstance& g : got) {
@@ -693,9 +693,9 @@ TEST_CASE("scene renderer: the particles reach the instance buffer far to near a
         return z;
     };
     renderer.setViewer({0.0f, 0.0f, 3.0f}, {0.0f, 0.0f, -1.0f}, 500.0f);
-    CHECK(uploadedZ() == std::vector<float>{-0.9f, -0.5f, 0.0f, 0.2f, 0.5f});
+    CHECK(uploadedZ() == std::vector<float>{-0.9f, -0.5f, 0.0f, 0.2f, 0.5f, 3.5f});
     renderer.setViewer({0.0f, 0.0f, -3.0f}, {0.0f, 0.0f, 1.0f}, 500.0f);
-    CHECK(uploadedZ() == std::vector<float>{0.5f, 0.2f, 0.0f, -0.5f, -0.9f});
+    CHECK(uploadedZ() == std::vector<float>{3.5f, 0.5f, 0.2f, 0.0f, -0.5f, -0.9f});
 }
 
 TEST_CASE("tumbler level of detail: the camera takes the far mesh while every tumbler is small on screen",
