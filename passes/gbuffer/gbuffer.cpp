@@ -23,7 +23,7 @@ public:
                        .doc = "the floor's grain baked over x, z in [-1,1] (2 mm texels), re-baked when its colours change"})
             .param(boolParam("particles", true, "draw the particles"))
             .param(enumParam("particle_mode", "points", {"points", "mesh"},
-                             "points: one point sprite per particle, shaded as a sphere; mesh: its octahedron"))
+                             "points: one point sprite per particle, the disc its sphere covers; mesh: its octahedron"))
             .param(enumParam("sphere_mode", "traced", {"traced", "mesh"},
                              "the marbles and fireballs: traced = each pixel's ray against the sphere over its "
                              "projected rectangle (exact silhouette, normal and depth; two triangles a sphere); "
