@@ -93,7 +93,8 @@ public:
                              "keep the lamp's light on the picture and recompute it only where instances moved "
                              "(and their shadows); every pixel when the camera, the lamp or anything upstream "
                              "but instances changed. Not with lamp_model traced or shadow_filter pcss (they "
-                             "recompute every pixel). Assumes the G-buffer and shadow map of gbuffer and shadow"))
+                             "recompute every pixel). Assumes the G-buffer and shadow map of gbuffer and shadow (whose "
+                             "particles write only emission: they are not followed)"))
             .param(intChoiceParam("direct_tile", 64, {16, 32, 64},
                                   "keep_direct: side in pixels of the square tiles the lamp's light is recomputed "
                                   "over. 64: llvmpipe's own tiles (at 16, composite took 20.1 against 17.4 ms at "
