@@ -4,14 +4,14 @@
 # and shaders, plus tests/fuzz_corpus/<target>/). Prints executions, seconds and crashes
 # per target; every crash/timeout/oom input is copied to tests/fuzz_corpus/<target>/,
 # where ctest replays it in every build ("fuzz: replay <target>"). Exit 1 on a crash.
-#   scripts/fuzz.sh [SECONDS_PER_TARGET] [TARGET...]     (targets: pipeline scene shader)
+#   scripts/fuzz.sh [SECONDS_PER_TARGET] [TARGET...]     (targets: pipeline scene shader gltf)
 # JOBS=N sets the build's parallelism (default: all cores); nice it on a shared machine.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 seconds="${1:-60}"
 shift || true
 targets=("$@")
-[ ${#targets[@]} -eq 0 ] && targets=(pipeline scene shader)
+[ ${#targets[@]} -eq 0 ] && targets=(pipeline scene shader gltf)
 build="$root/build-fuzz"
 cc="$(command -v clang-14 || command -v clang)"
 cxx="$(command -v clang++-14 || command -v clang++)"
@@ -21,7 +21,7 @@ if [ ! -f "$build/CMakeCache.txt" ]; then
 fi
 cmake --build "$build" --parallel "${JOBS:-$(nproc)}" --target "${targets[@]/#/fuzz_}"
 
-declare -A seeds=([pipeline]="$root/pipelines" [scene]="$root/scenes $root/tests/sim/data" [shader]="$root/shaders")
+declare -A seeds=([pipeline]="$root/pipelines" [gltf]="$root/scenes /usr/share/assimp/models/glTF2" [scene]="$root/scenes $root/tests/sim/data" [shader]="$root/shaders")
 status=0
 rows=()
 for t in "${targets[@]}"; do
