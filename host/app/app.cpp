@@ -124,6 +124,8 @@ SceneView App::buildView() {
     v.frame.tumblerShape = glm::vec4(look.tumblerB, look.tumblerT, look.tumblerAlpha,
                                      (look.tumblerB - look.tumblerT) / std::sin(look.tumblerAlpha));
     v.frame.boxWalls = glm::uvec4(boxWallBits(look.closed), 0u, 0u, 0u);
+    v.materialTextures[0] = renderer_.materialTexture(0);
+    v.materialTextures[1] = renderer_.materialTexture(1);
 
     if (v.frame.viewProj != lastViewProj_) lastViewProj_ = v.frame.viewProj, ++cameraVersion_;
     for (int i = 0; i < kSceneGeometryCount; ++i) {

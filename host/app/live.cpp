@@ -1,6 +1,7 @@
 #include "app/live.hpp"
 
 #include <chrono>
+#include <algorithm>
 #include <set>
 
 #include "app/app.hpp"
@@ -33,6 +34,18 @@ void LiveReload::start(App& app) {
     // Pipelines and scenes are JSON files; their directories may hold anything.
     watcher_->watch(canonical(app.runtime().pipelineFile()).parent_path(), FileWatcher::Depth::ThisDirectory, ".json");
     watcher_->watch(canonical(app.scene().file()).parent_path(), FileWatcher::Depth::ThisDirectory, ".json");
+    watchModels(app);
+}
+
+// The placed models' files (glTF, buffers, images): every file of their directories is
+// watched, the ones the models were read from reload them.
+void LiveReload::watchModels(App& app) {
+    for (const std::string& file : app.scene().modelFiles()) {
+        const fs::path dir = canonical(file).parent_path();
+        if (std::find(modelDirs_.begin(), modelDirs_.end(), dir) != modelDirs_.end()) continue;
+        modelDirs_.push_back(dir);
+        watcher_->watch(dir, FileWatcher::Depth::ThisDirectory);
+    }
 }
 
 namespace {
@@ -115,6 +128,12 @@ int LiveReload::retryModules(App& app) {
     return moduleReloads - before;
 }
 
+bool LiveReload::isModelFile(App& app, const fs::path& path) const {
+    for (const std::string& file : app.scene().modelFiles())
+        if (canonical(file) == path) return true;
+    return false;
+}
+
 int LiveReload::poll(App& app) {
     if (!watcher_) return 0;
     const int retried = pendingModules_.empty() ? 0 : retryModules(app);
@@ -139,9 +158,22 @@ int LiveReload::poll(App& app) {
                 log::error(errors);
                 ++failures;
             }
+        } else if (path != scene && isModelFile(app, path)) {
+            std::string error;
+            if (app.scene().reloadModels(error)) {
+                rt.setExternalError("scene", "");
+                log::info("reloaded the models of ", app.scene().file(), " in ", msSince(t0), " ms");
+                watchModels(app);
+                ++sceneReloads, ++reloads;
+            } else {
+                rt.setExternalError("scene", error + " (the last good models stay)");
+                log::error(error);
+                ++failures;
+            }
         } else if (path == scene) {
             std::string error;
             if (app.scene().load(path.string(), app.seedOverride(), error)) {
+                watchModels(app);
                 rt.setExternalError("scene", "");
                 log::info("reloaded scene ", path.string(), " in ", msSince(t0), " ms");
                 ++sceneReloads, ++reloads;

@@ -11,6 +11,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "kiln/file_watcher.hpp"
 
@@ -46,6 +47,9 @@ private:
         bool triedThisVersion = true;             // a reload was tried at this size + mtime
     };
     void reloadModule(App& app, const std::string& module, const std::filesystem::path& path);
+    void watchModels(App& app);
+    bool isModelFile(App& app, const std::filesystem::path& path) const;
+    std::vector<std::filesystem::path> modelDirs_;  // watched for the placed models' files
     int retryModules(App& app);
 
     std::unique_ptr<FileWatcher> watcher_;

@@ -2,8 +2,12 @@
 
 #include <algorithm>
 
+#include <filesystem>
+
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/type_ptr.hpp>
+
+#include "kiln/log.hpp"
 
 namespace kiln::scene {
 
@@ -54,17 +58,86 @@ std::vector<BodyInstance> bodiesOf(const sim::World& world, int highlighted) {
     return bodies;
 }
 
+bool isGltfFile(const std::string& path) {
+    const std::string ext = std::filesystem::path(path).extension().string();
+    return ext == ".gltf" || ext == ".glb";
+}
+
+// Where a model spec puts the model: translate × rotate (x, then y, then z) × scale,
+// after the fit into the box when it asks for one (its bounds on the floor, centred,
+// within x, z ∈ [-0.8, 0.8] and 1.4 high, under the lamp).
+glm::mat4 placementOf(const sim::Scene::ModelSpec& spec, const model::Model& m) {
+    glm::mat4 fit(1.0f);
+    if (spec.fit) {
+        const glm::vec3 extent = glm::max(m.boundsMax - m.boundsMin, glm::vec3(1e-6f));
+        const float s = std::min({1.6f / extent.x, 1.4f / extent.y, 1.6f / extent.z});
+        const glm::vec3 base(0.5f * (m.boundsMin.x + m.boundsMax.x), m.boundsMin.y, 0.5f * (m.boundsMin.z + m.boundsMax.z));
+        fit = glm::translate(glm::mat4(1.0f), glm::vec3(0.0f, -1.0f, 0.0f)) * glm::scale(glm::mat4(1.0f), glm::vec3(s)) *
+              glm::translate(glm::mat4(1.0f), -base);
+    }
+    const glm::vec3 r = glm::radians(glm::vec3(spec.rotationDeg));
+    glm::mat4 t = glm::translate(glm::mat4(1.0f), glm::vec3(spec.position));
+    t = glm::rotate(t, r.z, glm::vec3(0, 0, 1));
+    t = glm::rotate(t, r.y, glm::vec3(0, 1, 0));
+    t = glm::rotate(t, r.x, glm::vec3(1, 0, 0));
+    return t * glm::scale(glm::mat4(1.0f), glm::vec3(float(spec.scale))) * fit;
+}
+
 }  // namespace
+
+bool LiveScene::loadModels(const sim::Scene& scene, const std::string& sceneFile, std::vector<PlacedModel>& out,
+                           std::string& error) const {
+    namespace fs = std::filesystem;
+    out.clear();
+    for (size_t i = 0; i < scene.models.size(); ++i) {
+        const sim::Scene::ModelSpec& spec = scene.models[i];
+        fs::path file = spec.file;
+        if (file.is_relative() && !isGltfFile(sceneFile)) file = fs::path(sceneFile).parent_path() / file;
+        auto m = std::make_shared<model::Model>();
+        std::string why;
+        if (!model::loadGltf(file.string(), *m, why)) {
+            error = isGltfFile(sceneFile) ? why : sceneFile + ": models[" + std::to_string(i) + "].file: " + why;
+            return false;
+        }
+        for (const std::string& w : m->warnings) log::warn(file.string(), ": ", w);
+        out.push_back({m, placementOf(spec, *m)});
+    }
+    return true;
+}
 
 bool LiveScene::load(const std::string& sceneFile, std::optional<uint64_t> seed, std::string& error) {
     sim::Scene scene;
-    if (!sim::loadScene(sceneFile, scene, error)) return false;
+    if (isGltfFile(sceneFile)) {
+        // A model alone: the box and its lamp as the default scene has them, no bodies.
+        scene.models.push_back({sceneFile, glm::dvec3(0.0), 1.0, glm::dvec3(0.0), true});
+    } else if (!sim::loadScene(sceneFile, scene, error)) {
+        return false;
+    }
+    std::vector<PlacedModel> models;
+    if (!loadModels(scene, sceneFile, models, error)) return false;
     if (seed) scene.physics.seed = *seed;
     sim_.reset(scene);
+    spec_ = scene;
+    models_ = std::move(models);
+    ++modelsVersion_;
     file_ = sceneFile;
     look_ = lookOf(scene);
     ++generation_;
     return true;
+}
+
+bool LiveScene::reloadModels(std::string& error) {
+    std::vector<PlacedModel> models;
+    if (!loadModels(spec_, file_, models, error)) return false;
+    models_ = std::move(models);
+    ++modelsVersion_;
+    return true;
+}
+
+std::vector<std::string> LiveScene::modelFiles() const {
+    std::vector<std::string> files;
+    for (const PlacedModel& p : models_) files.insert(files.end(), p.model->files.begin(), p.model->files.end());
+    return files;
 }
 
 void LiveScene::writeTo(SceneRenderer& renderer, int highlighted) {
@@ -72,6 +145,11 @@ void LiveScene::writeTo(SceneRenderer& renderer, int highlighted) {
         renderer.setLook(look_);
         sentGeneration_ = generation_;
         sentBodies_ = sentParticles_ = sentFireballs_ = ~0ull;
+    }
+    if (sentModels_ != modelsVersion_) {
+        std::string error;
+        if (!renderer.setModels(models_, error)) log::error(file_, ": ", error, " (the last models stay)");
+        sentModels_ = modelsVersion_;
     }
     if (sim_.bodiesVersion() != sentBodies_ || highlighted != sentHighlight_) {
         renderer.setBodies(bodiesOf(sim_, highlighted));

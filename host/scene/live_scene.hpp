@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "kiln/sim/world.hpp"
 #include "scene/scene_renderer.hpp"
@@ -15,9 +16,16 @@ namespace kiln::scene {
 
 class LiveScene {
 public:
-    // Loads `sceneFile` (with `seed` instead of the file's physics.seed when given);
-    // on failure keeps the current world and returns false with a one-line error.
+    // Loads `sceneFile` (with `seed` instead of the file's physics.seed when given): a
+    // scene file (JSON), or a glTF file (.gltf, .glb) shown alone in the box, fitted to
+    // it. On failure keeps the current world and returns false with a one-line error.
     bool load(const std::string& sceneFile, std::optional<uint64_t> seed, std::string& error);
+    // Reads the placed models' files again, keeping the world as it is (a model saved
+    // live); false with a one-line error keeps the last good models.
+    bool reloadModels(std::string& error);
+    // Every file the placed models were read from (glTF, buffers, images).
+    std::vector<std::string> modelFiles() const;
+    const std::vector<PlacedModel>& models() const { return models_; }
     void step() { sim_.step(); }
     void reset() { sim_.reset(); }
     double time() const { return sim_.time(); }
@@ -35,7 +43,13 @@ public:
     void writeTo(SceneRenderer& renderer, int highlighted);
 
 private:
+    bool loadModels(const sim::Scene&, const std::string& sceneFile, std::vector<PlacedModel>& out,
+                    std::string& error) const;
+
     sim::World sim_;
+    sim::Scene spec_;  // as last loaded: its models are read again by reloadModels
+    std::vector<PlacedModel> models_;
+    uint64_t modelsVersion_ = 0, sentModels_ = 0;
     SceneLook look_;
     std::string file_;
     uint64_t generation_ = 0;

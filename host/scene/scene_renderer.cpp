@@ -5,6 +5,7 @@
 #include <cstring>
 
 #include <glm/gtc/matrix_transform.hpp>
+#include <stb_image_resize.h>
 
 #include "kiln/hash.hpp"
 #include "scene/mesh.hpp"
@@ -38,7 +39,25 @@ uint64_t farFirstKey(float depth, uint32_t i) {
 
 }  // namespace
 
-void SceneRenderer::buildMeshes(const SceneLook& look) {
+namespace {
+
+// Whether `m` is a rotation, a uniform scale and a translation with no mirror: what
+// scene.glsl's normal transform (mat3(model)) and the G-buffer's facing assume.
+bool isSimilarity(const glm::mat4& m) {
+    const glm::vec3 a(m[0]), b(m[1]), c(m[2]);
+    const float la = glm::length(a), lb = glm::length(b), lc = glm::length(c);
+    if (!(la > 0.0f)) return false;
+    const float tol = 1e-4f * la;
+    return std::abs(la - lb) < tol && std::abs(la - lc) < tol && std::abs(glm::dot(a, b)) < tol * la &&
+           std::abs(glm::dot(a, c)) < tol * la && std::abs(glm::dot(b, c)) < tol * la &&
+           glm::dot(glm::cross(a, b), c) > 0.0f && m[0][3] == 0.0f && m[1][3] == 0.0f && m[2][3] == 0.0f &&
+           m[3][3] == 1.0f;
+}
+
+}  // namespace
+
+void SceneRenderer::buildMeshes() {
+    const SceneLook& look = look_;
     auto tumbler = [&](const TumblerMesh& m) {
         return makeTumbler(look.tumblerB, look.tumblerT, look.tumblerAlpha, m.slices, m.stacks,
                            m.inflated ? areaPreservingInflation(look.tumblerB, m.slices) : 0.0f);
@@ -56,15 +75,74 @@ void SceneRenderer::buildMeshes(const SceneLook& look) {
         makeParticle(),
     };
     std::vector<Vertex> vertices;
+    std::vector<SurfaceVertex> surface;  // texture coordinates and tangents, a stream of their own
     std::vector<uint32_t> indices;
-    for (int i = 0; i < kMeshCount; ++i) {
+    meshes_.assign(kMeshCount, MeshRange{});
+    for (size_t i = 0; i < kMeshCount; ++i) {
         meshes_[i] = {static_cast<uint32_t>(indices.size()), static_cast<uint32_t>(data[i].indices.size()),
-                      static_cast<uint32_t>(vertices.size())};
+                              static_cast<uint32_t>(vertices.size())};
         vertices.insert(vertices.end(), data[i].vertices.begin(), data[i].vertices.end());
         indices.insert(indices.end(), data[i].indices.begin(), data[i].indices.end());
     }
+    surface.resize(vertices.size());
+    // The placed models: one mesh each of their meshes, and one more for each instance
+    // whose transform is no similarity (non-uniform scale, a mirror), baked into it.
+    meshInstances_.clear();
+    meshGroups_.clear();
+    auto addMesh = [&](const model::Mesh& m, const glm::mat4* bake) {
+        meshes_.push_back({static_cast<uint32_t>(indices.size()), static_cast<uint32_t>(m.indices.size()),
+                           static_cast<uint32_t>(vertices.size())});
+        const glm::mat3 normalMatrix = bake ? glm::transpose(glm::inverse(glm::mat3(*bake))) : glm::mat3(1.0f);
+        for (const model::Vertex& v : m.vertices) {
+            if (bake) {
+                const glm::vec3 p = glm::vec3(*bake * glm::vec4(v.position, 1.0f));
+                const glm::vec3 t = glm::mat3(*bake) * glm::vec3(v.tangent);
+                vertices.push_back({p, glm::normalize(normalMatrix * v.normal)});
+                surface.push_back({v.uv, glm::vec4(glm::length(t) > 0.0f ? glm::normalize(t) : glm::vec3(1, 0, 0),
+                                                   v.tangent.w * (glm::determinant(glm::mat3(*bake)) < 0 ? -1.0f : 1.0f))});
+            } else {
+                vertices.push_back({v.position, v.normal});
+                surface.push_back({v.uv, v.tangent});
+            }
+        }
+        const bool mirrored = bake && glm::determinant(glm::mat3(*bake)) < 0.0f;
+        for (size_t i = 0; i + 2 < m.indices.size(); i += 3) {
+            indices.push_back(m.indices[i]);
+            indices.push_back(m.indices[i + (mirrored ? 2 : 1)]);
+            indices.push_back(m.indices[i + (mirrored ? 1 : 2)]);
+        }
+        return uint32_t(meshes_.size() - 1);
+    };
+    uint32_t materialBase = 0;
+    for (const PlacedModel& placed : models_) {
+        const model::Model& mdl = *placed.model;
+        const uint32_t first = uint32_t(meshes_.size());
+        for (const model::Mesh& m : mdl.meshes) addMesh(m, nullptr);
+        // Instances grouped by mesh: each group one instanced draw.
+        std::vector<std::vector<glm::mat4>> byMesh(mdl.meshes.size());
+        for (const model::Instance& inst : mdl.instances) {
+            const glm::mat4 world = placed.placement * inst.transform;
+            if (isSimilarity(world)) {
+                byMesh[size_t(inst.mesh)].push_back(world);
+            } else {
+                const uint32_t baked = addMesh(mdl.meshes[size_t(inst.mesh)], &world);
+                meshGroups_.push_back({baked, 1});
+                meshInstances_.push_back(materialInstance(mdl, materialBase, mdl.meshes[size_t(inst.mesh)].material,
+                                                          glm::mat4(1.0f)));
+            }
+        }
+        for (size_t m = 0; m < byMesh.size(); ++m) {
+            if (byMesh[m].empty()) continue;
+            meshGroups_.push_back({first + uint32_t(m), uint32_t(byMesh[m].size())});
+            for (const glm::mat4& world : byMesh[m])
+                meshInstances_.push_back(materialInstance(mdl, materialBase, mdl.meshes[m].material, world));
+        }
+        materialBase += uint32_t(mdl.materials.size());
+    }
     vertexBuffer_ = gl::Buffer::create(static_cast<GLsizeiptr>(vertices.size() * sizeof(Vertex)), vertices.data(), 0,
                                        "scene.vertices");
+    surfaceBuffer_ = gl::Buffer::create(static_cast<GLsizeiptr>(surface.size() * sizeof(SurfaceVertex)),
+                                        surface.data(), 0, "scene.surface_vertices");
     indexBuffer_ = gl::Buffer::create(static_cast<GLsizeiptr>(indices.size() * sizeof(uint32_t)), indices.data(), 0,
                                       "scene.indices");
     if (!vao_) {
@@ -81,13 +159,42 @@ void SceneRenderer::buildMeshes(const SceneLook& look) {
         glVertexArrayAttribIFormat(vao, 2, 1, GL_UNSIGNED_INT, 0);
         glVertexArrayAttribBinding(vao, 2, 1);
         glVertexArrayBindingDivisor(vao, 1, 1);
+        // Texture coordinates and tangents in a stream of their own: a vertex shader that
+        // does not read them fetches nothing more than before.
+        glEnableVertexArrayAttrib(vao, 3);
+        glEnableVertexArrayAttrib(vao, 4);
+        glVertexArrayAttribFormat(vao, 3, 2, GL_FLOAT, GL_FALSE, offsetof(SurfaceVertex, uv));
+        glVertexArrayAttribFormat(vao, 4, 4, GL_FLOAT, GL_FALSE, offsetof(SurfaceVertex, tangent));
+        glVertexArrayAttribBinding(vao, 3, 2);
+        glVertexArrayAttribBinding(vao, 4, 2);
     }
     glVertexArrayVertexBuffer(vao_.id(), 0, vertexBuffer_.id(), 0, sizeof(Vertex));
+    glVertexArrayVertexBuffer(vao_.id(), 2, surfaceBuffer_.id(), 0, sizeof(SurfaceVertex));
     glVertexArrayElementBuffer(vao_.id(), indexBuffer_.id());
 }
 
+GpuInstance SceneRenderer::materialInstance(const model::Model& mdl, uint32_t materialBase, int material,
+                                            const glm::mat4& world) const {
+    GpuInstance g;
+    g.model = world;
+    const size_t key = material < 0 ? size_t(-1) : materialBase + uint32_t(material);
+    const MaterialLayers* layers = nullptr;
+    if (key != size_t(-1) && key < materialLayers_.size()) layers = &materialLayers_[key];
+    model::Material def;
+    const model::Material& m = material >= 0 ? mdl.materials[size_t(material)] : def;
+    const glm::vec3 emission = m.emissiveFactor * m.emissiveStrength;
+    g.baseColor = m.baseColorFactor;
+    g.emission = glm::vec4(emission, 0.0f);
+    g.albedo = glm::vec4(glm::vec3(m.baseColorFactor) * (layers ? layers->meanBase : glm::vec3(1.0f)), 0.0f);
+    g.emissive = glm::vec4(emission * (layers ? layers->meanEmissive : glm::vec3(1.0f)), 0.0f);
+    g.layers = glm::vec4(layers ? layers->base : -1.0f, layers ? layers->emissive : -1.0f, layers ? layers->normal : -1.0f,
+                         m.alphaMode == model::AlphaMode::Mask ? std::max(m.alphaCutoff, 1e-6f) : 0.0f);
+    return g;
+}
+
 void SceneRenderer::setLook(const SceneLook& look) {
-    buildMeshes(look);
+    look_ = look;
+    buildMeshes();
     staticInstances_.clear();
     auto wall = [&](glm::mat4 m, glm::vec3 albedo, float material) {
         staticInstances_.push_back({m, glm::vec4(albedo, material), glm::vec4(look.wallEmission, 0.0f)});
@@ -111,7 +218,115 @@ void SceneRenderer::setLook(const SceneLook& look) {
     for (int i = 0; i < kSceneGeometryCount; ++i) ++versions_[i], hashes_[i] = 0;
     noteContents(kSceneBox, staticInstances_.data(), walls);
     noteContents(kSceneLamp, staticInstances_.data() + walls, 1);
+    noteContents(kSceneMeshes, meshInstances_.data(), meshInstances_.size());
     dirty_ = true;
+}
+
+namespace {
+
+float srgbToLinear(uint8_t v) {
+    const float c = float(v) / 255.0f;
+    return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+}
+
+// GPU memory the placed meshes' texture layers may take, mips included.
+constexpr size_t kMaterialTextureBytes = size_t(1) << 30;
+
+}  // namespace
+
+bool SceneRenderer::buildMaterials(const std::vector<PlacedModel>& models, std::string& error) {
+    // Which images each array holds: (model, image) pairs in order of first use.
+    struct Use { const model::Model* model; int image; };
+    std::vector<Use> colorImages, dataImages;
+    auto layerOf = [](std::vector<Use>& list, const model::Model* m, int texture) -> float {
+        if (texture < 0 || m->textures[size_t(texture)].image < 0) return -1.0f;
+        const int image = m->textures[size_t(texture)].image;
+        for (size_t i = 0; i < list.size(); ++i)
+            if (list[i].model == m && list[i].image == image) return float(i);
+        list.push_back({m, image});
+        return float(list.size() - 1);
+    };
+    std::vector<MaterialLayers> layers;
+    int side = 1;
+    for (const PlacedModel& p : models)
+        for (const model::Material& mat : p.model->materials) {
+            MaterialLayers l;
+            l.base = layerOf(colorImages, p.model.get(), mat.baseColorTexture);
+            l.emissive = layerOf(colorImages, p.model.get(), mat.emissiveTexture);
+            l.normal = layerOf(dataImages, p.model.get(), mat.normalTexture);
+            layers.push_back(l);
+        }
+    for (const auto* list : {&colorImages, &dataImages})
+        for (const Use& u : *list) {
+            const model::Image& im = u.model->images[size_t(u.image)];
+            side = std::max({side, im.width, im.height});
+        }
+    side = std::min(side, kMaterialLayerSide);
+    const size_t layerCount = colorImages.size() + dataImages.size();
+    auto bytesAt = [&](int s) { return layerCount * size_t(s) * size_t(s) * 4 * 4 / 3; };
+    while (side > 64 && bytesAt(side) > kMaterialTextureBytes) side /= 2;
+    if (bytesAt(side) > kMaterialTextureBytes) {
+        error = std::to_string(layerCount) + " texture layers would take " + std::to_string(bytesAt(side) >> 20) +
+                " MiB even at " + std::to_string(side) + " texels a side, over the " +
+                std::to_string(kMaterialTextureBytes >> 20) + " MiB Kiln gives material textures";
+        return false;
+    }
+    std::vector<uint8_t> pixels(size_t(side) * size_t(side) * 4);
+    auto upload = [&](std::vector<Use>& list, bool srgb, gl::TextureHandle& target, const char* name,
+                      std::vector<glm::vec3>& means) {
+        target.reset();
+        means.assign(list.size(), glm::vec3(1.0f));
+        if (list.empty()) return;
+        GLuint id = 0;
+        glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, &id);
+        target = gl::TextureHandle(id);
+        gl::label(GL_TEXTURE, id, name);
+        const int levels = gl::Texture::fullMipCount(side, side, 1);
+        glTextureStorage3D(id, levels, srgb ? GL_SRGB8_ALPHA8 : GL_RGBA8, side, side, GLsizei(list.size()));
+        for (size_t i = 0; i < list.size(); ++i) {
+            const model::Image& im = list[i].model->images[size_t(list[i].image)];
+            const uint8_t* src = im.rgba.data();
+            if (im.width != side || im.height != side) {
+                if (srgb)
+                    stbir_resize_uint8_srgb(im.rgba.data(), im.width, im.height, 0, pixels.data(), side, side, 0, 4, 3, 0);
+                else
+                    stbir_resize_uint8(im.rgba.data(), im.width, im.height, 0, pixels.data(), side, side, 0, 4);
+                src = pixels.data();
+            }
+            glTextureSubImage3D(id, 0, 0, 0, GLint(i), side, side, 1, GL_RGBA, GL_UNSIGNED_BYTE, src);
+            glm::dvec3 sum(0.0);
+            const size_t n = size_t(side) * size_t(side);
+            for (size_t t = 0; t < n; ++t)
+                sum += glm::dvec3(srgbToLinear(src[t * 4]), srgbToLinear(src[t * 4 + 1]), srgbToLinear(src[t * 4 + 2]));
+            means[i] = glm::vec3(sum / double(n));
+        }
+        glGenerateTextureMipmap(id);
+        glTextureParameteri(id, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+        glTextureParameteri(id, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+        glTextureParameteri(id, GL_TEXTURE_WRAP_S, GL_REPEAT);
+        glTextureParameteri(id, GL_TEXTURE_WRAP_T, GL_REPEAT);
+    };
+    std::vector<glm::vec3> colorMeans, dataMeans;
+    upload(colorImages, true, colorLayers_, "scene.material_colors", colorMeans);
+    upload(dataImages, false, dataLayers_, "scene.material_data", dataMeans);
+    for (MaterialLayers& l : layers) {
+        if (l.base >= 0.0f) l.meanBase = colorMeans[size_t(l.base)];
+        if (l.emissive >= 0.0f) l.meanEmissive = colorMeans[size_t(l.emissive)];
+    }
+    materialLayers_ = std::move(layers);
+    return true;
+}
+
+bool SceneRenderer::setModels(const std::vector<PlacedModel>& models, std::string& error) {
+    if (!buildMaterials(models, error)) return false;
+    models_ = models;
+    buildMeshes();
+    // The meshes may differ with the same instances (a model edited live).
+    ++versions_[sceneCategoryIndex(kSceneMeshes)];
+    noteContents(kSceneMeshes, meshInstances_.data(), meshInstances_.size());
+    movedUnbounded_ = true;
+    dirty_ = true;
+    return true;
 }
 
 void SceneRenderer::noteContents(SceneCategory c, const GpuInstance* begin, size_t count) {
@@ -240,6 +455,10 @@ void SceneRenderer::rebuildGroups() {
     // far), particles.
     add(kQuad, kSceneBox);
     add(kLamp, kSceneLamp);
+    for (const auto& [mesh, n] : meshGroups_) {
+        groups_.push_back({mesh, kSceneMeshes, Lod::High, true, cursor, n});
+        cursor += n;
+    }
     if (const uint32_t n = count(kSceneTumblers); n > 0) {
         const MeshId camera = tumblersNear_ ? kTumblerNearMesh : kTumblerFarMesh;
         groups_.push_back({camera, kSceneTumblers, Lod::High, false, cursor, n});
@@ -258,8 +477,9 @@ void SceneRenderer::upload() {
     chooseLevels();
     rebuildGroups();
     std::vector<GpuInstance> all;
-    all.reserve(staticInstances_.size() + bodyInstances_.size() + particleInstances_.size());
+    all.reserve(staticInstances_.size() + meshInstances_.size() + bodyInstances_.size() + particleInstances_.size());
     all.insert(all.end(), staticInstances_.begin(), staticInstances_.end());
+    all.insert(all.end(), meshInstances_.begin(), meshInstances_.end());
     all.insert(all.end(), bodyInstances_.begin(), bodyInstances_.end());
     // The particles far to near along the view: the G-buffer draws them without writing
     // depth (passes/gbuffer), so where two cover a pixel the nearer must come last, as

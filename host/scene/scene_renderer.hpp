@@ -12,11 +12,13 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <vector>
 
 #include "kiln/gl.hpp"
 #include "kiln/scene_view.hpp"
+#include "model/model.hpp"
 #include "run/pass_context.hpp"
 
 namespace kiln::scene {
@@ -44,6 +46,17 @@ struct BodyInstance {
     glm::vec3 emissive{0.0f};
     bool highlighted = false;
 };
+
+// A model (glTF) placed in the scene: its instances' transforms are applied after
+// `placement`.
+struct PlacedModel {
+    std::shared_ptr<const model::Model> model;
+    glm::mat4 placement{1.0f};
+};
+
+// The most texels a side of the placed meshes' texture layers (every layer of an array
+// has one size: larger images are scaled down to it).
+inline constexpr int kMaterialLayerSide = 1024;
 
 struct ParticleInstance {
     glm::vec3 position;
@@ -91,6 +104,11 @@ public:
     void setLook(const SceneLook&);
     void setBodies(const std::vector<BodyInstance>&);
     void setParticles(const std::vector<ParticleInstance>&);
+    // The models the scene file places (kSceneMeshes): their meshes, instances and
+    // textures. Returns false with a one-line error (GPU memory) and keeps the last ones.
+    bool setModels(const std::vector<PlacedModel>&, std::string& error);
+    // The texture arrays of SceneView::materialTextures (0 where there are none).
+    GLuint materialTexture(int which) const { return which == 0 ? colorLayers_.id() : dataLayers_.id(); }
     // The camera, for the spheres' level of detail and the particles' order: its
     // position, the unit vector it looks along, and the pixels a unit length spans at
     // unit distance (projection[1][1] × height / 2).
@@ -112,17 +130,33 @@ public:
     std::optional<std::vector<glm::vec4>> takeMovedBodies();
 
 private:
-    enum MeshId {
+    // The generated meshes; the placed models' follow them in meshes_.
+    enum MeshId : uint32_t {
         kQuad, kLamp, kTumblerNearMesh, kTumblerFarMesh, kTumblerShadowMesh, kTumblerVoxelMesh,
         kSphereHigh, kSphereMid, kSphereLow, kParticle, kMeshCount
     };
     struct MeshRange { uint32_t firstIndex = 0, indexCount = 0, baseVertex = 0; };
-    struct Group { MeshId mesh; SceneCategory category; Lod lod; bool anyLod; uint32_t first, count; };
+    struct Group { uint32_t mesh; SceneCategory category; Lod lod; bool anyLod; uint32_t first, count; };
     // Calls visit(group) for each group draw() issues for the filter.
     template <class Visit>
     void forEachGroupDrawn(const DrawFilter&, Visit visit) const;
 
-    void buildMeshes(const SceneLook&);
+    void buildMeshes();
+    // The placed models' images as layers of the two texture arrays; false (nothing
+    // changed) when they would not fit the GPU memory they are given.
+    bool buildMaterials(const std::vector<PlacedModel>&, std::string& error);
+    // A placed mesh's instance: its transform and its material's factors and layers.
+    GpuInstance materialInstance(const model::Model&, uint32_t materialBase, int material, const glm::mat4& world) const;
+
+    struct SurfaceVertex {  // the second vertex stream (attributes 3 and 4)
+        glm::vec2 uv{0.0f};
+        glm::vec4 tangent{1.0f, 0.0f, 0.0f, 1.0f};
+    };
+    struct MaterialLayers {  // one per material of the placed models, in their order
+        float base = -1.0f, emissive = -1.0f, normal = -1.0f;
+        glm::vec3 meanBase{1.0f}, meanEmissive{1.0f};  // the textures' mean (linear), for coarse passes
+    };
+    std::vector<MaterialLayers> materialLayers_;
     void rebuildGroups();
     // Orders each sphere category's instances near → mid → far by their size on
     // screen and keeps the three counts in sphereLevels_; whether any tumbler is near.
@@ -130,8 +164,15 @@ private:
     void noteContents(SceneCategory, const GpuInstance* begin, size_t count);
     void noteMovedBodies();
 
-    std::array<MeshRange, kMeshCount> meshes_{};
-    gl::Buffer vertexBuffer_, indexBuffer_;
+    std::vector<MeshRange> meshes_;
+    SceneLook look_;
+    std::vector<PlacedModel> models_;
+    // Per placed model mesh (in models_ order): its first mesh in meshes_; the instances
+    // of kSceneMeshes, grouped by mesh (meshInstanceCounts_ each).
+    std::vector<GpuInstance> meshInstances_;
+    std::vector<std::pair<uint32_t, uint32_t>> meshGroups_;  // (mesh, instances)
+    gl::Buffer vertexBuffer_, surfaceBuffer_, indexBuffer_;
+    gl::TextureHandle colorLayers_, dataLayers_;
     gl::VertexArrayHandle vao_;
     gl::Buffer instanceBuffer_, instanceIds_;
     size_t instanceCapacity_ = 0;

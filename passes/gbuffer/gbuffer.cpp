@@ -28,7 +28,7 @@ public:
                              "the marbles and fireballs: traced = each pixel's ray against the sphere over its "
                              "projected rectangle (exact silhouette, normal and depth; two triangles a sphere); "
                              "mesh = their UV-sphere meshes by size on screen"));
-        d.reads = kSceneStatic | kSceneBodies | kSceneParticles | kSceneCamera;
+        d.reads = kSceneStatic | kSceneMeshes | kSceneBodies | kSceneParticles | kSceneCamera;
         return d;
     }
 
@@ -49,7 +49,15 @@ public:
             tracedSpheres ? ctx.program({.stages = {"gbuffer/sphere.vert", "gbuffer/sphere.frag"}}) : 0;
         GLuint bake = ctx.program({.stages = {"gbuffer/wood.comp"}});
         GLuint background = ctx.program({.stages = {"gbuffer/background.vert", "gbuffer/background.frag"}});
-        if (!program || !woodProgram || !bake || !background || (points && !pointProgram) ||
+        // The placed meshes' materials, each texture array's lookups only where it exists.
+        const kiln::SceneView& scene = ctx.scene();
+        const bool meshes = scene.count(kiln::kSceneMeshes) > 0;
+        GLuint texturedProgram =
+            meshes ? ctx.program({.stages = {"gbuffer/textured.vert", "gbuffer/textured.frag"},
+                                  .defines = {{"KILN_HAS_COLOR_LAYERS", scene.materialTextures[0] ? "1" : "0"},
+                                              {"KILN_HAS_DATA_LAYERS", scene.materialTextures[1] ? "1" : "0"}}})
+                   : 0;
+        if (!program || !woodProgram || !bake || !background || (points && !pointProgram) || (meshes && !texturedProgram) ||
             (particles && !points && !particleMeshProgram) ||
             (tracedSpheres && !sphereProgram))
             return;
@@ -90,10 +98,16 @@ public:
             glCullFace(GL_BACK);
             ctx.drawScene({.categories = tracedSpheres ? kiln::kSceneTumblers : kiln::kSceneBodies});
             glDisable(GL_CULL_FACE);
-            if (tracedSpheres) {
-                drawTracedSpheres(ctx, sphereProgram);
-                glUseProgram(program);
+            if (tracedSpheres) drawTracedSpheres(ctx, sphereProgram);
+            if (meshes) {
+                // Either side may show (a glTF surface is open or double-sided): the back
+                // face's normal is turned to the viewer, as the walls' are.
+                glUseProgram(texturedProgram);
+                kiln::gl::bindTexture(texturedProgram, "u_colorLayers", scene.materialTextures[0]);
+                kiln::gl::bindTexture(texturedProgram, "u_dataLayers", scene.materialTextures[1]);
+                ctx.drawScene({.categories = kiln::kSceneMeshes});
             }
+            glUseProgram(program);
             ctx.drawScene({.categories = kiln::kSceneStatic});
             // The floor, the one wood-grained instance (a wall of the box).
             glUseProgram(woodProgram);

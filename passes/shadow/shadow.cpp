@@ -36,7 +36,7 @@ public:
                              "the casters' meshes: fine (the finest: tumblers at 48 slices, 32-segment spheres), "
                              "medium (24 slices, 16-segment spheres), coarse (the voxelizer's: 8, 10) or auto: "
                              "medium up to a 1024² map"));
-        d.reads = kSceneShadowCasters | kSceneLight;
+        d.reads = kSceneShadowCasters | kSceneMeshes | kSceneLight;
         return d;
     }
 
@@ -46,13 +46,14 @@ public:
         const float one = 1.0f;
         glClearBufferfv(GL_DEPTH, 0, &one);
         // No caster: the cleared map (everything lit) is the answer.
-        if (ctx.scene().count(kiln::kSceneShadowCasters) == 0) return;
+        if (ctx.scene().count(kiln::kSceneShadowCasters | kiln::kSceneMeshes) == 0) return;
         glEnable(GL_DEPTH_TEST);
         glDepthFunc(GL_LESS);
         glEnable(GL_POLYGON_OFFSET_FILL);
         glPolygonOffset(ctx.getFloat("slope_bias"), 4.0f);
         glUseProgram(program);
-        ctx.drawScene({.categories = kiln::kSceneShadowCasters, .lod = casterLod(ctx)});
+        // The placed meshes cast at every level (they have one mesh each).
+        ctx.drawScene({.categories = kiln::kSceneShadowCasters | kiln::kSceneMeshes, .lod = casterLod(ctx)});
     }
 };
 

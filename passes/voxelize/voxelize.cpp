@@ -166,7 +166,7 @@ public:
                                   "cover and tests the fireballs against the cap: 16³ cost 1.5 ms at 720² on "
                                   "llvmpipe, 8³ 0.4). The lamp is large, so the fraction changes slowly away "
                                   "from the fire"));
-        d.reads = kSceneStatic | kSceneBodies | kSceneParticles | kSceneLight;
+        d.reads = kSceneStatic | kSceneMeshes | kSceneBodies | kSceneParticles | kSceneLight;
         return d;
     }
 
@@ -248,7 +248,7 @@ private:
         // The debug view edits a parameter on the same object: the two the voxels depend
         // on are in the key (lamp_model and fire_cover change the programs).
         const StaticKey key{scene.version(kiln::kSceneLamp), scene.version(kiln::kSceneLight),
-                            scene.version(kiln::kSceneBox), scene.frame.woodLight, scene.frame.woodDark,
+                            scene.version(kiln::kSceneBox), scene.version(kiln::kSceneMeshes), scene.frame.woodLight, scene.frame.woodDark,
                             staticSums.id, raster, recorder, res, ctx.getFloat("lamp_emission"),
                             ctx.getBool("conservative")};
         if (key == builtStatic_) return true;
@@ -270,7 +270,7 @@ private:
             beginRaster(ctx, recorder, res, staticSums.id);
             glUniform1f(glGetUniformLocation(recorder, "u_emissionScale"), 1.0f);
             glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kStaticBinding, staticFragments_.id());
-            ctx.drawScene({.categories = kiln::kSceneBox, .lod = kiln::Lod::Low});
+            ctx.drawScene({.categories = kiln::kSceneBox | kiln::kSceneMeshes, .lod = kiln::Lod::Low});
             glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
             glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
                             GL_BUFFER_UPDATE_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
@@ -337,7 +337,7 @@ private:
         if (rasterStatic) drawDome(ctx, raster);
         const GLint emissionScale = glGetUniformLocation(raster, "u_emissionScale");
         glUniform1i(glGetUniformLocation(raster, "u_unshadowed"), 0);
-        uint32_t cats = (rasterStatic ? kiln::kSceneBox : 0u) | (rasterTumblers ? kiln::kSceneTumblers : 0u);
+        uint32_t cats = (rasterStatic ? kiln::kSceneBox | kiln::kSceneMeshes : 0u) | (rasterTumblers ? kiln::kSceneTumblers : 0u);
         if (rasterParticles) cats |= kiln::kSceneParticles;
         if (ctx.getBool("marbles")) cats |= kiln::kSceneMarbles;
         glUniform1f(emissionScale, 1.0f);
@@ -490,7 +490,7 @@ private:
     // What `static_sums` and the recorded fragments were last built from (a cache: a
     // module reload starts over).
     struct StaticKey {
-        uint64_t lampVersion = 0, lightVersion = 0, boxVersion = 0;
+        uint64_t lampVersion = 0, lightVersion = 0, boxVersion = 0, meshesVersion = 0;
         glm::vec4 woodLight{-1.0f}, woodDark{-1.0f};  // the floor's grain (its albedo)
         GLuint texture = 0, program = 0, recorder = 0;
         int resolution = 0;

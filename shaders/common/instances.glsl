@@ -2,8 +2,11 @@
 // any stage, e.g. a fragment shader given the instance index as a flat varying.
 struct KilnInstance {
     mat4 model;
-    vec4 albedo;    // rgb, a = material (0 plain, 1 wood grain)
-    vec4 emissive;  // rgb radiance, a = highlight
+    vec4 albedo;     // rgb mean albedo, a = material (0 plain, 1 wood grain)
+    vec4 emissive;   // rgb mean radiance, a = highlight
+    vec4 baseColor;  // textured: × the base colour texture (rgb albedo, a coverage)
+    vec4 emission;   // textured: × the emissive texture (radiance)
+    vec4 layers;     // x base colour, y emissive, z normal map layer (-1 none), w alpha cutoff (0 opaque)
 };
 layout(std430, binding = 0) readonly buffer KilnInstances { KilnInstance kiln_instances[]; };
 

@@ -8,9 +8,9 @@
 #include "common/frame.glsl"
 #include "common/instances.glsl"
 
-const int kBox = 0, kLamp = 1, kTumblers = 2, kMarbles = 3, kFireballs = 4, kParticles = 5;
-uniform int u_first[6];
-uniform int u_count[6];
+const int kBox = 0, kLamp = 1, kMeshes = 2, kTumblers = 3, kMarbles = 4, kFireballs = 5, kParticles = 6;
+uniform int u_first[7];
+uniform int u_count[7];
 
 const float kNoHit = 1e30;
 

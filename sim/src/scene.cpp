@@ -172,6 +172,41 @@ bool balls(const Json& root, const std::string& key, std::vector<Scene::BallSpec
     return true;
 }
 
+// The models the scene places (the renderer draws them; the simulation's bodies do not
+// collide with them).
+bool models(const Json& root, std::vector<Scene::ModelSpec>& out, SceneError& error) {
+    if (!root.contains("models")) return true;
+    if (!root["models"].is_array()) {
+        error = {"models", std::string("expected an array, got ") + typeName(root["models"])};
+        return false;
+    }
+    if (root["models"].size() > kMaxModels) {
+        error = {"models", "more than " + std::to_string(kMaxModels) + " models"};
+        return false;
+    }
+    for (size_t i = 0; i < root["models"].size(); ++i) {
+        const Json& m = root["models"][i];
+        const std::string path = "models[" + std::to_string(i) + "]";
+        if (!m.is_object()) {
+            error = {path, std::string("expected an object, got ") + typeName(m)};
+            return false;
+        }
+        Scene::ModelSpec spec;
+        Reader r{m, path, error, {"file"}};
+        if (!m.contains("file") || !m["file"].is_string() || m["file"].get<std::string>().empty()) {
+            error = {path + ".file", "expected the glTF file's path (relative to the scene file), got " +
+                                         (m.contains("file") ? shown(m["file"]) : std::string("nothing"))};
+            return false;
+        }
+        spec.file = m["file"].get<std::string>();
+        if (!r.vec<3>("position", spec.position, -1e4, 1e4) || !r.number("scale", spec.scale, 1e-6, 1e6) ||
+            !r.vec<3>("rotation_deg", spec.rotationDeg, -360.0, 360.0) || !r.boolean("fit", spec.fit) || !r.finish())
+            return false;
+        out.push_back(spec);
+    }
+    return true;
+}
+
 bool restitution(const Json& physics, Scene::Physics::Restitution& e, SceneError& error) {
     const Json* o = nullptr;
     if (!object(physics, "restitution", "physics.restitution", error, o)) return false;
@@ -429,9 +464,11 @@ static bool readScene(const Json& root, Scene& out, SceneError& error) {
     if (!readBox(root, s, error) || !readLamp(root, s, error) || !readPhysics(root, s, error) ||
         !readShape(root, s, error) || !readTumblers(root, s, error) || !checkTumblerPoses(s, error))
         return false;
-    if (!balls(root, "marbles", s.marbles, 0.05, error) || !balls(root, "fireballs", s.fireballs, 0.06, error))
+    if (!balls(root, "marbles", s.marbles, 0.05, error) || !balls(root, "fireballs", s.fireballs, 0.06, error) ||
+        !models(root, s.models, error))
         return false;
-    Reader top{root, "", error, {"box", "lamp", "physics", "tumbler_shape", "tumblers", "marbles", "fireballs", "$schema"}};
+    Reader top{root, "", error,
+               {"box", "lamp", "physics", "tumbler_shape", "tumblers", "marbles", "fireballs", "models", "$schema"}};
     if (!top.finish()) return false;
     out = std::move(s);
     return true;

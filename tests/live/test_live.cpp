@@ -256,3 +256,55 @@ TEST_CASE("shaders/ deleted and checked out again is watched again: its changed 
     writeByRename(composite, forcedComposite(original, "vec3(1.0, 0.0, 0.0)"));
     CHECK(box.waitFor([&] { return near(box.centre(), {1, 0, 0}); }));
 }
+
+namespace {
+// A square x, y ∈ [-0.6, 0.6] at z = 0 facing the camera, of base colour `rgb`, as glTF
+// with its buffer in a data URI; `index` replaces its last index (4 is beyond its vertices).
+std::string squareGltf(const char* rgb, int lastIndex = 3) {
+    // Positions (-.6,-.6,0) (.6,-.6,0) (.6,.6,0) (-.6,.6,0) as float32, then six uint8 indices.
+    const float p[12] = {-0.6f, -0.6f, 0, 0.6f, -0.6f, 0, 0.6f, 0.6f, 0, -0.6f, 0.6f, 0};
+    std::vector<uint8_t> bin(reinterpret_cast<const uint8_t*>(p), reinterpret_cast<const uint8_t*>(p) + 48);
+    for (int i : {0, 1, 2, 0, 2, lastIndex}) bin.push_back(uint8_t(i));
+    static const char* table = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    std::string b64;
+    for (size_t i = 0; i < bin.size(); i += 3) {
+        uint32_t v = uint32_t(bin[i]) << 16 | uint32_t(i + 1 < bin.size() ? bin[i + 1] : 0) << 8 |
+                     (i + 2 < bin.size() ? bin[i + 2] : 0);
+        b64 += table[(v >> 18) & 63];
+        b64 += table[(v >> 12) & 63];
+        b64 += i + 1 < bin.size() ? table[(v >> 6) & 63] : '=';
+        b64 += i + 2 < bin.size() ? table[v & 63] : '=';
+    }
+    return std::string(R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+      "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "material": 0}]}],
+      "materials": [{"pbrMetallicRoughness": {"baseColorFactor": [)") + rgb + R"(, 1]}}],
+      "accessors": [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3"},
+                    {"bufferView": 0, "byteOffset": 48, "componentType": 5121, "count": 6, "type": "SCALAR"}],
+      "bufferViews": [{"buffer": 0, "byteLength": 54}],
+      "buffers": [{"byteLength": 54, "uri": "data:application/octet-stream;base64,)" + b64 + R"("}]})";
+}
+}  // namespace
+
+TEST_CASE("a glTF model saved live re-renders, a broken save keeps the last good model", "[live][gl]") {
+    Sandbox box("gltf-edit");
+    const fs::path scene = box.root / "scenes/cornell.json";
+    const fs::path model = box.root / "scenes/square.gltf";
+    writeInPlace(model, squareGltf("1, 0, 0"));
+    writeByRename(scene, R"({"tumblers": [], "models": [{"file": "square.gltf"}]})");
+    auto centreAlbedo = [&] { return box.centreOf("gbuffer.albedo"); };
+    REQUIRE(box.waitFor([&] { return std::abs(centreAlbedo().r - 1.0f) < 0.01f && centreAlbedo().g < 0.01f; }));
+    // Saved in place (the world keeps its state: no reset), then by rename.
+    writeInPlace(model, squareGltf("0, 1, 0"));
+    CHECK(box.waitFor([&] { return centreAlbedo().g > 0.99f && centreAlbedo().r < 0.01f; }));
+    writeByRename(model, squareGltf("0, 0, 1"));
+    CHECK(box.waitFor([&] { return centreAlbedo().b > 0.99f && centreAlbedo().g < 0.01f; }));
+    // An index beyond the vertices: named at its JSON path, the blue square stays.
+    writeByRename(model, squareGltf("1, 1, 0", 4));
+    CHECK(box.waitFor([&] { return box.errorMentions("square.gltf: meshes[0].primitives[0].indices: index 4"); }));
+    for (int i = 0; i < 3; ++i) box.app.frame();
+    CHECK(centreAlbedo().b > 0.99f);
+    // Fixed again: the error clears and the new colour shows.
+    writeByRename(model, squareGltf("1, 1, 1"));
+    CHECK(box.waitFor([&] { return centreAlbedo().r > 0.99f && centreAlbedo().g > 0.99f; }));
+    CHECK_FALSE(box.errorMentions("square.gltf"));
+}

@@ -148,22 +148,24 @@ enum SceneCategory : uint32_t {
     kSceneNone = 0,
     kSceneBox = 1u << 0,        // the five walls (the floor carries the wood grain)
     kSceneLamp = 1u << 1,       // the emissive dome under the ceiling
-    kSceneTumblers = 1u << 2,
-    kSceneMarbles = 1u << 3,
-    kSceneFireballs = 1u << 4,
-    kSceneParticles = 1u << 5,
-    kSceneLight = 1u << 6,      // the lamp's position, size and radiance
-    kSceneCamera = 1u << 7,
-    kSceneTime = 1u << 8,
+    kSceneMeshes = 1u << 2,     // static meshes a scene file places (glTF models), with their
+                                //   materials and textures (SceneView::materialTextures)
+    kSceneTumblers = 1u << 3,
+    kSceneMarbles = 1u << 4,
+    kSceneFireballs = 1u << 5,
+    kSceneParticles = 1u << 6,
+    kSceneLight = 1u << 7,      // the lamp's position, size and radiance
+    kSceneCamera = 1u << 8,
+    kSceneTime = 1u << 9,
 
     kSceneStatic = kSceneBox | kSceneLamp,
     kSceneBodies = kSceneTumblers | kSceneMarbles | kSceneFireballs,
-    kSceneShadowCasters = kSceneTumblers | kSceneMarbles,  // fireballs emit, they don't cast
-    kSceneGeometry = 0x3f,      // what drawScene() can draw
-    kSceneAll = 0x1ff,
+    kSceneShadowCasters = kSceneTumblers | kSceneMarbles,  // the moving casters; fireballs emit, they don't cast
+    kSceneGeometry = 0x7f,      // what drawScene() can draw
+    kSceneAll = 0x3ff,
 };
-inline constexpr int kSceneCategoryCount = 9;
-inline constexpr int kSceneGeometryCount = 6;
+inline constexpr int kSceneCategoryCount = 10;
+inline constexpr int kSceneGeometryCount = 7;
 
 struct PassDeclaration {
     std::vector<InputDecl> inputs;

@@ -62,8 +62,8 @@
 //   params     name, type, default, range or choices: they drive the JSON validation
 //              and the debug UI. Read them in execute() with ctx.getFloat("name") etc.
 //   reads      the scene categories you read (SceneCategory in kiln/declare.hpp:
-//              kSceneShadowCasters, kSceneBodies, kSceneLight, kSceneCamera, ...). The
-//              geometry bits are also what ctx.drawScene() filters on.
+//              kSceneMeshes, kSceneShadowCasters, kSceneBodies, kSceneLight, kSceneCamera,
+//              ...). The geometry bits are also what ctx.drawScene() filters on.
 //
 // SKIPPING
 //   The host re-runs a pass only when an input's version, a parameter, a scene
@@ -225,9 +225,11 @@ namespace kiln {
 // between passes; 7: GpuFrame::boxWalls; 8: PassContext::keepRunning; 9:
 // SizeRule::capSource and Lod::Medium; 10: ProgramBuild::portability; 11:
 // FrameInfo::redraw; 12: TextureRef::setup; 13: Lod::Fine, and Lod::High's tumblers by
-// their size on screen; 14: PassContext::isRead and TextureDecl::onlyWhenRead), so a
-// module built for other terms is refused by name, not run.
-inline constexpr uint32_t kPassAbiVersion = 14;
+// their size on screen; 14: PassContext::isRead and TextureDecl::onlyWhenRead; 15:
+// kSceneMeshes (the bits after it moved up), GpuInstance's material fields and
+// SceneView::materialTextures), so a module built for other terms is refused by name,
+// not run.
+inline constexpr uint32_t kPassAbiVersion = 15;
 
 struct TextureRef {
     GLuint id = 0;

@@ -33,8 +33,19 @@ struct DrawFilter {
 // sync with shaders/common/instances.glsl.
 struct alignas(16) GpuInstance {
     glm::mat4 model;
-    glm::vec4 albedo;    // rgb, a = material (0 plain, 1 wood grain)
-    glm::vec4 emissive;  // rgb radiance (already × strength), a = highlight (picked) 0/1
+    glm::vec4 albedo;    // rgb: the mean albedo (a textured surface's averaged over its texture,
+                         //   for passes that see the scene coarsely), a = material (0 plain,
+                         //   1 wood grain)
+    glm::vec4 emissive;  // rgb: the mean emitted radiance (already × strength), a = highlight
+                         //   (picked) 0/1
+    // The placed meshes' materials (kSceneMeshes; other categories leave these at their
+    // defaults and read albedo and emissive): per texel, albedo = baseColor.rgb × the base colour texture, coverage
+    // = baseColor.a × its alpha, radiance = emission.rgb × the emissive texture.
+    glm::vec4 baseColor{1.0f};
+    glm::vec4 emission{0.0f};
+    glm::vec4 layers{-1.0f, -1.0f, -1.0f, 0.0f};  // x base colour, y emissive (layers of
+                         //   SceneView::materialTextures[0]), z normal map (of [1]); -1 none;
+                         //   w: the alpha cutoff (0: opaque)
 };
 
 // The per-frame uniform block (std140, binding kFrameBinding); keep in sync with
@@ -73,6 +84,10 @@ constexpr int sceneCategoryIndex(uint32_t c) {
 
 struct SceneView {
     GpuFrame frame{};
+    // The placed meshes' textures: GL_TEXTURE_2D_ARRAY names, [0] sRGB colour (base colour
+    // and emissive layers), [1] linear data (normal maps, rgb = xyz × 0.5 + 0.5 in tangent
+    // space); layers chosen by GpuInstance::layers. 0 when the scene has none.
+    uint32_t materialTextures[2] = {0, 0};
     // Bumped by the host whenever that category changed (geometry: its instance
     // contents; light: the lamp; camera: the view-projection; time: a step).
     uint64_t versions[kSceneCategoryCount] = {};

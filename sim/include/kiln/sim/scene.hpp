@@ -40,8 +40,13 @@
 //     "tumblers": [                               // required (may be empty)
 //       { "position": [x, z], "tilt": [about_x, about_z], "color": [r,g,b] } ],
 //     "marbles":   [ { "position": [x,y,z], "velocity": [x,y,z], "radius": 0.05, "color": [r,g,b] } ],
-//     "fireballs": [ { "position": [x,y,z], "velocity": [x,y,z], "radius": 0.06, "color": [r,g,b] } ]
-//   }
+//     "fireballs": [ { "position": [x,y,z], "velocity": [x,y,z], "radius": 0.06, "color": [r,g,b] } ],
+//     "models": [                                 // glTF 2.0 files drawn in the box (the bodies
+//       { "file": "model.glb",                    //   pass through them); the path is relative
+//         "position": [x,y,z], "scale": 1,        //   to the scene file. Placed by translate ×
+//         "rotation_deg": [x,y,z],                //   rotate (about x, then y, then z) × scale,
+//         "fit": false } ]                        //   or, with "fit", scaled and moved so its
+//   }                                             //   bounds stand on the floor within [-0.8,0.8]
 //
 // Every key is optional except "tumblers" and each entry's "position"; missing ones take
 // the defaults below. Unknown keys are errors (a typo would otherwise be silently
@@ -72,6 +77,7 @@ namespace kiln::sim {
 inline constexpr size_t kMaxTumblers = 64;
 inline constexpr size_t kMaxMarbles = 1024;
 inline constexpr size_t kMaxFireballs = 64;
+inline constexpr size_t kMaxModels = 64;
 inline constexpr int kMaxSceneNesting = 32;  // as the pipeline loader
 inline constexpr size_t kMaxSceneFileBytes = size_t(16) << 20;
 // The longest fixed sub-step (adaptive sub-steps off) a scene may ask for; longer ones
@@ -137,6 +143,15 @@ struct Scene {
     };
     std::vector<TumblerSpec> tumblers;
     std::vector<BallSpec> marbles, fireballs;
+    struct ModelSpec {
+        std::string file;             // as the scene file gives it
+        glm::dvec3 position{0.0};
+        double scale = 1.0;
+        glm::dvec3 rotationDeg{0.0};  // about x, then y, then z
+        bool fit = false;             // scaled and moved to stand inside the box (position,
+                                      //   scale and rotation then apply after the fit)
+    };
+    std::vector<ModelSpec> models;
 };
 
 // Either a scene or an error (never both).

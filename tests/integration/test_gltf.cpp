@@ -1,0 +1,242 @@
+// glTF models in the box, on screen: a texture's texels where its UVs put them, cut-outs,
+// a normal map's shading normal against the closed form, a model's shadow, and the
+// command line on shipped and broken files.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include <nlohmann/json.hpp>
+
+#include "app/app.hpp"
+#include "kiln/image_io.hpp"
+#include "support/headless.hpp"
+#include "support/run_kiln.hpp"
+
+namespace fs = std::filesystem;
+using namespace kiln;
+
+namespace {
+
+constexpr int kSize = 160;
+
+std::string base64(const std::vector<uint8_t>& bytes) {
+    static const char* table = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    std::string out;
+    for (size_t i = 0; i < bytes.size(); i += 3) {
+        uint32_t v = uint32_t(bytes[i]) << 16;
+        if (i + 1 < bytes.size()) v |= uint32_t(bytes[i + 1]) << 8;
+        if (i + 2 < bytes.size()) v |= bytes[i + 2];
+        out += table[(v >> 18) & 63];
+        out += table[(v >> 12) & 63];
+        out += i + 1 < bytes.size() ? table[(v >> 6) & 63] : '=';
+        out += i + 2 < bytes.size() ? table[v & 63] : '=';
+    }
+    return out;
+}
+
+// A 64×64 PNG whose four quadrants (as the image is seen, top row first) have the
+// colours given: top-left, top-right, bottom-left, bottom-right (RGBA, 0..1).
+void writeQuadrants(const fs::path& file, const std::array<glm::vec4, 4>& colors) {
+    FloatImage img;
+    img.width = img.height = 64;
+    img.channels = 4;
+    img.pixels.resize(64 * 64 * 4);
+    for (int y = 0; y < 64; ++y)
+        for (int x = 0; x < 64; ++x) {
+            const int rowFromTop = 63 - y;  // FloatImage rows go bottom up
+            const glm::vec4 c = colors[size_t((rowFromTop >= 32 ? 2 : 0) + (x >= 32 ? 1 : 0))];
+            for (int k = 0; k < 4; ++k) img.at(x, y)[k] = c[k];
+        }
+    std::string error;
+    REQUIRE(writePng(file.string(), img, 4, error));
+}
+
+// A square x, y ∈ [-h, h] at z = zq facing +z (the camera), its UVs glTF's way: (0, 0)
+// at the image's top-left, which is the square's top-left as the camera sees it.
+nlohmann::json squareGltf(float h, float zq, const std::string& image, const nlohmann::json& material) {
+    const std::vector<float> pos = {-h, h, zq, h, h, zq, h, -h, zq, -h, -h, zq};
+    const std::vector<float> uv = {0, 0, 1, 0, 1, 1, 0, 1};
+    const std::vector<uint16_t> idx = {0, 3, 2, 0, 2, 1};
+    std::vector<uint8_t> bin;
+    auto append = [&](const void* p, size_t n) {
+        bin.insert(bin.end(), static_cast<const uint8_t*>(p), static_cast<const uint8_t*>(p) + n);
+    };
+    append(pos.data(), pos.size() * 4);
+    append(uv.data(), uv.size() * 4);
+    append(idx.data(), idx.size() * 2);
+    bin.resize((bin.size() + 3) / 4 * 4);
+    nlohmann::json j = {
+        {"asset", {{"version", "2.0"}}},
+        {"scene", 0},
+        {"scenes", {{{"nodes", {0}}}}},
+        {"nodes", {{{"mesh", 0}}}},
+        {"meshes", {{{"primitives", {{{"attributes", {{"POSITION", 0}, {"TEXCOORD_0", 1}}}, {"indices", 2}, {"material", 0}}}}}}},
+        {"accessors",
+         {{{"bufferView", 0}, {"componentType", 5126}, {"count", 4}, {"type", "VEC3"}},
+          {{"bufferView", 1}, {"componentType", 5126}, {"count", 4}, {"type", "VEC2"}},
+          {{"bufferView", 2}, {"componentType", 5123}, {"count", 6}, {"type", "SCALAR"}}}},
+        {"bufferViews",
+         {{{"buffer", 0}, {"byteOffset", 0}, {"byteLength", 48}},
+          {{"buffer", 0}, {"byteOffset", 48}, {"byteLength", 32}},
+          {{"buffer", 0}, {"byteOffset", 80}, {"byteLength", 12}}}},
+        {"buffers", {{{"byteLength", bin.size()}, {"uri", "data:application/octet-stream;base64," + base64(bin)}}}},
+        {"materials", {material}},
+    };
+    if (!image.empty()) j["images"] = {{{"uri", image}}}, j["textures"] = {{{"source", 0}}};
+    return j;
+}
+
+// A scene file with the box, no bodies, and the model `gltf` (written beside it).
+std::string sceneWith(const std::string& name, const nlohmann::json& gltf) {
+    const fs::path dir = fs::path(TEST_OUTPUT_DIR) / "gltf";
+    fs::create_directories(dir);
+    std::ofstream(dir / (name + ".gltf")) << gltf.dump();
+    const fs::path scene = dir / (name + ".json");
+    std::ofstream(scene) << nlohmann::json({{"tumblers", nlohmann::json::array()},
+                                            {"models", {{{"file", name + ".gltf"}}}}})
+                                .dump();
+    return scene.string();
+}
+
+struct Rig {
+    app::App app;
+    explicit Rig(const std::string& scene) {
+        REQUIRE(test::ensureHeadlessContext());
+        app::Options o = test::pausedHeadlessOptions(kSize);
+        o.scene = scene;
+        std::string error;
+        INFO(error);
+        REQUIRE(app.init(o, error));
+        app.runtime().setRequested({"composite.hdr"});
+        app.frame();
+        app.settle();
+    }
+    glm::ivec2 pixelOf(const glm::vec3& world) {
+        const glm::mat4 vp = app.camera().projection(1.0f) * app.camera().view();
+        const glm::vec4 c = vp * glm::vec4(world, 1.0f);
+        return glm::ivec2((glm::vec2(c) / c.w * 0.5f + 0.5f) * float(kSize));
+    }
+    glm::vec4 at(const char* pass, const char* name, const glm::vec3& world) {
+        const FloatImage img = test::readOutput(app, pass, name);
+        const glm::ivec2 p = pixelOf(world);
+        REQUIRE(p.x >= 0);
+        REQUIRE(p.y >= 0);
+        REQUIRE(p.x < img.width);
+        REQUIRE(p.y < img.height);
+        const float* v = img.at(p.x, p.y);
+        return {v[0], v[1], v[2], img.channels > 3 ? v[3] : 1.0f};
+    }
+};
+
+const std::array<glm::vec4, 4> kQuadrants = {glm::vec4(1, 0, 0, 1), glm::vec4(0, 1, 0, 1), glm::vec4(0, 0, 1, 1),
+                                             glm::vec4(1, 1, 1, 1)};
+
+}  // namespace
+
+TEST_CASE("a glTF texture's texels land where its UVs put them, sRGB decoded", "[gltf][gl]") {
+    const fs::path dir = fs::path(TEST_OUTPUT_DIR) / "gltf";
+    fs::create_directories(dir);
+    writeQuadrants(dir / "quadrants.png", kQuadrants);
+    // Base colour factor (1, 0.5, 1): the green quadrant shows at half.
+    const auto gltf = squareGltf(0.5f, -0.2f, "quadrants.png",
+                                 {{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}},
+                                                            {"baseColorFactor", {1.0, 0.5, 1.0, 1.0}}}}});
+    Rig rig(sceneWith("textured", gltf));
+    // Each quadrant's centre, as the camera sees the square: top-left red, top-right
+    // green, bottom-left blue, bottom-right white. 255 and 0 are exact in sRGB and linear.
+    const struct { glm::vec3 world; glm::vec3 albedo; } expected[] = {
+        {{-0.25f, 0.25f, -0.2f}, {1, 0, 0}},
+        {{0.25f, 0.25f, -0.2f}, {0, 0.5f, 0}},
+        {{-0.25f, -0.25f, -0.2f}, {0, 0, 1}},
+        {{0.25f, -0.25f, -0.2f}, {1, 0.5f, 1}},
+    };
+    for (const auto& e : expected) {
+        const glm::vec4 a = rig.at("gbuffer", "albedo", e.world);
+        INFO("at " << e.world.x << ", " << e.world.y << ": " << a.r << " " << a.g << " " << a.b);
+        // RGBA8 albedo: within 1/255 and rounding.
+        for (int c = 0; c < 3; ++c) CHECK(std::abs(a[c] - e.albedo[c]) <= 1.5f / 255.0f);
+    }
+}
+
+TEST_CASE("an alpha-masked glTF material cuts holes where coverage is below the cutoff", "[gltf][gl]") {
+    const fs::path dir = fs::path(TEST_OUTPUT_DIR) / "gltf";
+    fs::create_directories(dir);
+    // The top-right quadrant transparent (alpha 0.2 below the cutoff 0.5).
+    writeQuadrants(dir / "cutout.png", {glm::vec4(1, 0, 0, 1), glm::vec4(0, 1, 0, 0.2f), glm::vec4(0, 0, 1, 1),
+                                        glm::vec4(1, 1, 1, 1)});
+    const auto gltf = squareGltf(0.5f, -0.2f, "cutout.png",
+                                 {{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}},
+                                  {"alphaMode", "MASK"}, {"alphaCutoff", 0.5}});
+    Rig rig(sceneWith("cutout", gltf));
+    // Through the hole: the back wall (colour "other", 0.85 0.82 0.78), farther than the square.
+    const glm::vec4 hole = rig.at("gbuffer", "albedo", {0.25f, 0.25f, -0.2f});
+    CHECK(std::abs(hole.r - 0.85f) < 0.01f);
+    CHECK(std::abs(hole.g - 0.82f) < 0.01f);
+    const glm::vec4 solid = rig.at("gbuffer", "albedo", {-0.25f, 0.25f, -0.2f});
+    CHECK(solid.r > 0.99f);
+    CHECK(solid.g < 0.01f);
+    const float holeDepth = rig.at("gbuffer", "depth", {0.25f, 0.25f, -0.2f}).r;
+    const float solidDepth = rig.at("gbuffer", "depth", {-0.25f, 0.25f, -0.2f}).r;
+    CHECK(holeDepth > solidDepth);
+}
+
+TEST_CASE("a glTF normal map turns the shading normal as the closed form says", "[gltf][gl]") {
+    const fs::path dir = fs::path(TEST_OUTPUT_DIR) / "gltf";
+    fs::create_directories(dir);
+    // Tangent space normal (sin 40°, 0, cos 40°): with u along +x (the tangent, generated
+    // from the UVs: no TANGENT in the file) and the face's normal +z, the world normal is
+    // (sin 40°, 0, cos 40°).
+    const float s = std::sin(glm::radians(40.0f)), c = std::cos(glm::radians(40.0f));
+    const glm::vec4 encoded(s * 0.5f + 0.5f, 0.5f, c * 0.5f + 0.5f, 1.0f);
+    writeQuadrants(dir / "normals.png", {encoded, encoded, encoded, encoded});
+    auto gltf = squareGltf(0.5f, -0.2f, "normals.png", {{"normalTexture", {{"index", 0}}}});
+    Rig rig(sceneWith("normal_mapped", gltf));
+    const glm::vec4 n = rig.at("gbuffer", "normal", {0.1f, 0.1f, -0.2f});
+    INFO(n.x << " " << n.y << " " << n.z);
+    // 8-bit texels: each component within 1/255 of the encoded value, ×2 decoded, and
+    // a 16-bit float normal.
+    CHECK(std::abs(n.x - s) < 0.01f);
+    CHECK(std::abs(n.y) < 0.01f);
+    CHECK(std::abs(n.z - c) < 0.01f);
+}
+
+TEST_CASE("a glTF model casts the lamp's shadow", "[gltf][gl]") {
+    // A horizontal plate at y = -0.5 over the floor's centre (facing up): the floor
+    // under it is in the lamp's shadow; the floor beside it is lit.
+    nlohmann::json gltf = squareGltf(0.3f, 0.0f, "", {{"pbrMetallicRoughness", {{"baseColorFactor", {0.8, 0.8, 0.8, 1.0}}}}});
+    gltf["nodes"][0]["translation"] = {0.0, -0.5, 0.2};
+    gltf["nodes"][0]["rotation"] = {-std::sqrt(0.5), 0.0, 0.0, std::sqrt(0.5)};  // +z turned to +y
+    Rig rig(sceneWith("plate", gltf));
+    // The lamp's direct light: the plate covers the whole lamp from the floor under it
+    // (the lamp spans 9.5° from there, the plate 31°).
+    const glm::vec4 under = rig.at("composite", "direct", {0.0f, -1.0f, 0.2f});
+    const glm::vec4 beside = rig.at("composite", "direct", {0.7f, -1.0f, 0.6f});
+    INFO("under " << under.r << ", beside " << beside.r);
+    CHECK(beside.r > 0.05f);
+    CHECK(under.r < 0.02f * beside.r);
+
+}
+
+TEST_CASE("kiln --scene renders assimp-testmodels' 2CylinderEngine.glb and names a broken glTF", "[gltf][gl]") {
+    const std::string models = "/usr/share/assimp/models/glTF2";
+    const fs::path out = fs::path(TEST_OUTPUT_DIR) / "gltf" / "engine.png";
+    fs::create_directories(out.parent_path());
+    const auto ok = test::runKiln("--headless --size 96x96 --frames 2 --scene " + models +
+                                  "/2CylinderEngine-glTF-Binary/2CylinderEngine.glb --out " + out.string());
+    INFO(ok.out << ok.err);
+    REQUIRE(ok.exitCode == 0);
+    FloatImage img;
+    std::string error;
+    REQUIRE(readPng(out.string(), img, error));
+    // The engine stands in the middle of the box: the centre pixel is no wall's colour
+    // and not black.
+    const float* centre = img.at(48, 40);
+    CHECK(centre[0] + centre[1] + centre[2] > 0.02f);
+    const auto bad = test::runKiln("--headless --size 32x32 --frames 1 --scene " + models +
+                                   "/IndexOutOfRange/IndexOutOfRange.gltf --out " + out.string());
+    INFO(bad.out << bad.err);
+    CHECK(bad.exitCode != 0);
+    CHECK(bad.err.find("IndexOutOfRange.gltf: meshes[0].primitives[0].indices: index") != std::string::npos);
+}
