@@ -9,6 +9,7 @@
 #include <cmath>
 
 #include "kiln/log.hpp"
+#include "scene/punctual.hpp"
 #include "scene/redraw_region.hpp"
 
 namespace kiln::app {
@@ -124,6 +125,9 @@ SceneView App::buildView() {
     v.frame.tumblerShape = glm::vec4(look.tumblerB, look.tumblerT, look.tumblerAlpha,
                                      (look.tumblerB - look.tumblerT) / std::sin(look.tumblerAlpha));
     v.frame.boxWalls = glm::uvec4(boxWallBits(look.closed), 0u, 0u, 0u);
+    v.frame.sceneMin = glm::vec4(scene_.boundsMin(), 0.0f);
+    v.frame.sceneMax = glm::vec4(scene_.boundsMax(), 0.0f);
+    scene::packPunctualLights(scene_.lights(), scene_.boundsMin(), scene_.boundsMax(), v.frame);
     v.materialTextures[0] = renderer_.materialTexture(0);
     v.materialTextures[1] = renderer_.materialTexture(1);
 
@@ -133,7 +137,7 @@ SceneView App::buildView() {
         v.versions[i] = renderer_.version(c);
         v.counts[i] = renderer_.count(c);
     }
-    v.versions[sceneCategoryIndex(kSceneLight)] = scene_.generation();
+    v.versions[sceneCategoryIndex(kSceneLight)] = scene_.lightsVersion();
     v.versions[sceneCategoryIndex(kSceneCamera)] = cameraVersion_;
     v.versions[sceneCategoryIndex(kSceneTime)] = timeVersion_;
     return v;

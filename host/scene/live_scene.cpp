@@ -118,8 +118,7 @@ bool LiveScene::load(const std::string& sceneFile, std::optional<uint64_t> seed,
     if (seed) scene.physics.seed = *seed;
     sim_.reset(scene);
     spec_ = scene;
-    models_ = std::move(models);
-    ++modelsVersion_;
+    placeModels(std::move(models));
     file_ = sceneFile;
     look_ = lookOf(scene);
     ++generation_;
@@ -129,9 +128,34 @@ bool LiveScene::load(const std::string& sceneFile, std::optional<uint64_t> seed,
 bool LiveScene::reloadModels(std::string& error) {
     std::vector<PlacedModel> models;
     if (!loadModels(spec_, file_, models, error)) return false;
+    placeModels(std::move(models));
+    return true;
+}
+
+void LiveScene::placeModels(std::vector<PlacedModel> models) {
     models_ = std::move(models);
     ++modelsVersion_;
-    return true;
+    lights_.clear();
+    boundsMin_ = glm::vec3(-1.0f), boundsMax_ = glm::vec3(1.0f);  // the box
+    for (const PlacedModel& p : models_) {
+        const glm::mat4& m = p.placement;
+        const float scale = std::cbrt(std::abs(glm::determinant(glm::mat3(m))));
+        for (model::Light l : p.model->lights) {
+            l.position = glm::vec3(m * glm::vec4(l.position, 1.0f));
+            l.direction = glm::normalize(glm::mat3(m) * l.direction);
+            if (l.type != model::Light::Type::Directional) l.intensity *= scale * scale, l.range *= scale;
+            lights_.push_back(l);
+        }
+        for (int c = 0; c < 8; ++c) {
+            const glm::vec3 corner((c & 1) ? p.model->boundsMax.x : p.model->boundsMin.x,
+                                   (c & 2) ? p.model->boundsMax.y : p.model->boundsMin.y,
+                                   (c & 4) ? p.model->boundsMax.z : p.model->boundsMin.z);
+            const glm::vec3 w = glm::vec3(m * glm::vec4(corner, 1.0f));
+            boundsMin_ = glm::min(boundsMin_, w), boundsMax_ = glm::max(boundsMax_, w);
+        }
+    }
+    if (lights_.size() > size_t(kMaxPunctualLights))
+        log::warn(file_, ": ", lights_.size(), " punctual lights; the first ", kMaxPunctualLights, " are drawn");
 }
 
 std::vector<std::string> LiveScene::modelFiles() const {

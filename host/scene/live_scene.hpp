@@ -26,6 +26,14 @@ public:
     // Every file the placed models were read from (glTF, buffers, images).
     std::vector<std::string> modelFiles() const;
     const std::vector<PlacedModel>& models() const { return models_; }
+    // The placed models' punctual lights in world space. A model placed at scale s has its
+    // point and spot lights' intensity × s², so it is lit as its file shows it.
+    const std::vector<model::Light>& lights() const { return lights_; }
+    // The scene's bounds: the box's and the placed models'.
+    glm::vec3 boundsMin() const { return boundsMin_; }
+    glm::vec3 boundsMax() const { return boundsMax_; }
+    // Changes whenever the lamp or a punctual light may have changed.
+    uint64_t lightsVersion() const { return generation_ * 1'000'003ull + modelsVersion_; }
     void step() { sim_.step(); }
     void reset() { sim_.reset(); }
     double time() const { return sim_.time(); }
@@ -48,7 +56,11 @@ private:
 
     sim::World sim_;
     sim::Scene spec_;  // as last loaded: its models are read again by reloadModels
+    void placeModels(std::vector<PlacedModel> models);
+
     std::vector<PlacedModel> models_;
+    std::vector<model::Light> lights_;
+    glm::vec3 boundsMin_{-1.0f}, boundsMax_{1.0f};
     uint64_t modelsVersion_ = 0, sentModels_ = 0;
     SceneLook look_;
     std::string file_;

@@ -48,6 +48,9 @@ public:
             .input({.name = "shadow_map", .kind = TextureKind::Depth2D, .required = false})
             .input({.name = "indirect", .required = false, .fallback = Fallback::Black})
             .input({.name = "bloom", .required = false, .fallback = Fallback::Black})
+            .input({.name = "light_shadows", .kind = TextureKind::Depth2D, .required = false,
+                    .fallback = Fallback::FarDepth,
+                    .doc = "the punctual lights' shadow atlas (lights.shadow_atlas); read only when the scene has them"})
             .output({.name = "color", .format = Format::RGBA8, .doc = "tonemapped, gamma-encoded final image"})
             .output({.name = "hdr", .format = Format::RGBA16F,
                      .doc = "linear radiance before bloom, exposure and tonemapping; written only when read",
@@ -128,6 +131,7 @@ public:
                                             {"KILN_PCSS", pcss ? "1" : "0"},
                                             {"KILN_LAMP_THROUGH_FIRE", ctx.getBool("lamp_through_fire") ? "1" : "0"},
                                             {"KILN_FIREBALLS_ANALYTIC", ctx.getEnum("fireball_light") == "analytic" ? "1" : "0"},
+                                            {"KILN_PUNCTUAL", ctx.scene().frame.punctualCount.x > 0 ? "1" : "0"},
                                             {"KILN_DIRECT", std::to_string(direct)},
                                             {"KILN_HDR", hdr_ ? "1" : "0"},
                                             {"KILN_GAMMA_FIT", gammaFit_.usable() ? "1" : "0"}}});
@@ -234,6 +238,7 @@ private:
         kiln::gl::bindTexture(program, "u_shadowDepth", ctx.input("shadow_map").id);  // pcss only
         kiln::gl::bindTexture(program, "u_lampField", lampField_.id());  // field only
         kiln::gl::bindTexture(program, "u_direct", ctx.internal("direct").id);  // reading the kept light only
+        kiln::gl::bindTexture(program, "u_lightShadows", ctx.input("light_shadows").id);  // punctual lights only
         const std::string& tonemap = ctx.getEnum("tonemap");
         glUniform1f(glGetUniformLocation(program, "u_exposure"), ctx.getFloat("exposure"));
         glUniform1f(glGetUniformLocation(program, "u_ambient"), ctx.getFloat("ambient"));

@@ -90,6 +90,9 @@ public:
         const auto cube = SizeRule::fromParam("resolution");
         d.input({.name = "shadow_map", .kind = TextureKind::Depth2D, .required = false,
                  .doc = "the lamp's depth map (shadow.depth); unbound: everything lit"})
+            .input({.name = "light_shadows", .kind = TextureKind::Depth2D, .required = false,
+                    .fallback = Fallback::FarDepth,
+                    .doc = "the punctual lights' shadow atlas (lights.shadow_atlas); read only when the scene has them"})
             .output({.name = "radiance", .kind = TextureKind::Color3D, .format = Format::RGBA16F, .size = cube,
                      .doc = "rgb = mean outgoing radiance × occupancy, a = occupancy (0/1)"})
             .output({.name = "albedo", .kind = TextureKind::Color3D, .format = Format::RGBA8, .size = cube,
@@ -178,7 +181,8 @@ public:
         const kiln::Defines lamp = {{"KILN_LAMP_CONTOUR", contour ? "1" : "0"},
                                     {"KILN_LAMP_SAMPLES", contour || field ? "16" : "32"},
                                     {"KILN_LAMP_FIELD", field ? "1" : "0"},
-                                    {"KILN_FIRE_THROUGH", fireCover ? "1" : "0"}};
+                                    {"KILN_FIRE_THROUGH", fireCover ? "1" : "0"},
+                                    {"KILN_PUNCTUAL", ctx.scene().frame.punctualCount.x > 0 ? "1" : "0"}};
         const std::vector<std::string> rasterStages = {"voxelize/voxelize.vert", "voxelize/voxelize.geom",
                                                        "voxelize/voxelize.frag"};
         GLuint raster = ctx.program({.stages = rasterStages, .defines = lamp});
@@ -357,6 +361,7 @@ private:
         glUseProgram(program);
         kiln::gl::bindTexture(program, "u_shadowMap", ctx.input("shadow_map").id);
         kiln::gl::bindTexture(program, "u_lampField", ctx.internal("lamp_field").id);  // field only
+        kiln::gl::bindTexture(program, "u_lightShadows", ctx.input("light_shadows").id);  // punctual lights only
         bindSums(ctx, program, GL_READ_WRITE);
         glUniform1i(glGetUniformLocation(program, "u_res"), res);
         glUniform1f(glGetUniformLocation(program, "u_shadowBias"), ctx.getFloat("shadow_bias"));

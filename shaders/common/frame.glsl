@@ -1,4 +1,12 @@
 // The per-frame uniforms the host binds for every pass (kiln/scene_view.hpp GpuFrame).
+const int kMaxPunctualLights = 16;  // kiln/scene_view.hpp
+struct KilnPunctualLight {
+    vec4 position;   // xyz, w = type (0 directional, 1 point, 2 spot)
+    vec4 direction;  // xyz unit, where it shines; w = range (0: infinite)
+    vec4 color;      // rgb × intensity; w = shadow atlas tile (-1: none)
+    vec4 cone;       // spot: x cos(outer), y 1 / (cos(inner) − cos(outer))
+    mat4 shadowViewProj;
+};
 layout(std140, binding = 0) uniform KilnFrame {
     mat4 u_view;
     mat4 u_proj;
@@ -13,4 +21,8 @@ layout(std140, binding = 0) uniform KilnFrame {
     vec4 u_woodDark;     // rgb
     vec4 u_tumblerShape; // round cone: b, t, α (rad), y_t (upper centre above the lower)
     uvec4 u_boxWalls;    // x: faces of [-1,1]³ with a wall, bit 2a: −axis a, 2a+1: +axis a
+    vec4 u_sceneMin;     // the scene's bounds, world space
+    vec4 u_sceneMax;
+    uvec4 u_punctualCount;  // x: u_punctual[0 .. x) are lights
+    KilnPunctualLight u_punctual[kMaxPunctualLights];
 };

@@ -13,6 +13,7 @@
 #include "common/shadow.glsl"
 #include "common/lamp_field.glsl"
 #include "common/tonemap.glsl"
+#include "common/punctual.glsl"
 
 #ifndef KILN_DIRECT
 #define KILN_DIRECT 0
@@ -175,6 +176,12 @@ vec3 shade(ivec2 px, vec2 uv, vec3 lampLit, vec3 albedo) {
     vec3 direct = lampLit;
 #if KILN_LAMP_THROUGH_FIRE
     direct *= indirectLight.a;  // through the fire (common/fire.glsl), upsampled
+#endif
+#if KILN_PUNCTUAL
+    if (texelFetch(u_normal, px, 0).w > 0.5) {
+        vec3 p = worldPosition(uv, texelFetch(u_depth, px, 0).r);
+        direct += albedo / 3.14159265 * punctualIrradiance(p, normalize(texelFetch(u_normal, px, 0).xyz));
+    }
 #endif
 #if KILN_FIREBALLS_ANALYTIC
     if (texelFetch(u_normal, px, 0).w > 0.5) {

@@ -10,6 +10,7 @@
 #include "common/wood.glsl"
 #include "sums.glsl"
 #include "surface.glsl"
+#include "common/punctual.glsl"
 #if KILN_RECORD_STATIC
 #include "static_surfaces.glsl"
 #endif
@@ -66,7 +67,11 @@ void main() {
                                            ivec4(voxelAt(k0, ij, v_axis), v_axis | (kLast - k0 + 1) << 2));
     }
 #else
-    uvec3 lit = toFixedRadiance(lampReflected(albedo, v_world, n));
+    vec3 reflected = lampReflected(albedo, v_world, n);
+#if KILN_PUNCTUAL
+    reflected += albedo / 3.14159265 * punctualIrradiance(v_world, n);
+#endif
+    uvec3 lit = toFixedRadiance(reflected);
 #endif
     for (int k = k0; k <= kLast; ++k) addSurfaceToVoxel(voxelAt(k, ij, v_axis), lit, emitted, albedo, n);
 }

@@ -102,10 +102,11 @@ std::string sceneWith(const std::string& name, const nlohmann::json& gltf) {
 
 struct Rig {
     app::App app;
-    explicit Rig(const std::string& scene) {
+    explicit Rig(const std::string& scene, const std::string& pipeline = {}) {
         REQUIRE(test::ensureHeadlessContext());
         app::Options o = test::pausedHeadlessOptions(kSize);
         o.scene = scene;
+        if (!pipeline.empty()) o.pipeline = pipeline;
         std::string error;
         INFO(error);
         REQUIRE(app.init(o, error));
@@ -239,4 +240,97 @@ TEST_CASE("kiln --scene renders assimp-testmodels' 2CylinderEngine.glb and names
     INFO(bad.out << bad.err);
     CHECK(bad.exitCode != 0);
     CHECK(bad.err.find("IndexOutOfRange.gltf: meshes[0].primitives[0].indices: index") != std::string::npos);
+}
+
+namespace {
+// A glTF with no mesh and one light node: `light` (KHR_lights_punctual) at `translation`
+// turned by `rotation` (a quaternion x, y, z, w).
+nlohmann::json lightGltf(const nlohmann::json& light, std::vector<float> translation, std::vector<float> rotation) {
+    return {{"asset", {{"version", "2.0"}}},
+            {"scene", 0},
+            {"scenes", {{{"nodes", {0}}}}},
+            {"extensionsUsed", {"KHR_lights_punctual"}},
+            {"extensions", {{"KHR_lights_punctual", {{"lights", {light}}}}}},
+            {"nodes", {{{"translation", translation}, {"rotation", rotation},
+                        {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}}}}};
+}
+// The box with its lamp off, no bodies, and the light model `name`; the direct light only
+// (G-buffer, the lights' shadows, composite without indirect or ambient light).
+std::pair<std::string, std::string> directOnly(const std::string& name, const nlohmann::json& gltf) {
+    const fs::path dir = fs::path(TEST_OUTPUT_DIR) / "gltf";
+    fs::create_directories(dir);
+    std::ofstream(dir / (name + ".gltf")) << gltf.dump();
+    const fs::path scene = dir / (name + ".json");
+    std::ofstream(scene) << nlohmann::json({{"tumblers", nlohmann::json::array()},
+                                            {"lamp", {{"intensity", 0.0}}},
+                                            {"models", {{{"file", name + ".gltf"}}}}})
+                                .dump();
+    const fs::path pipeline = dir / "direct_only.json";
+    std::ofstream(pipeline) << R"({"output": "composite.color", "passes": [
+        {"id": "gbuffer", "module": "gbuffer"}, {"id": "lights", "module": "lights"},
+        {"id": "composite", "module": "composite", "params": {"ambient": 0.0},
+         "inputs": {"albedo": "gbuffer.albedo", "normal": "gbuffer.normal", "depth": "gbuffer.depth",
+                    "emissive": "gbuffer.emissive", "light_shadows": "lights.shadow_atlas"}}]})";
+    return {scene.string(), pipeline.string()};
+}
+const float kDown = std::sqrt(0.5f);  // the quaternion (-kDown, 0, 0, kDown) turns -z to -y
+}  // namespace
+
+TEST_CASE("a spot light's irradiance is I/d² under it and its cone's edge falls where its angle puts it",
+          "[gltf][gl]") {
+    // 1.5 m above the floor, pointing down: inner 29°, outer 30° (a 1° ramp).
+    const auto [scene, pipeline] = directOnly(
+        "spot", lightGltf({{"type", "spot"}, {"color", {1.0, 1.0, 1.0}}, {"intensity", 6.0},
+                           {"spot", {{"innerConeAngle", glm::radians(29.0)}, {"outerConeAngle", glm::radians(30.0)}}}},
+                          {0.0f, 0.5f, 0.0f}, {-kDown, 0.0f, 0.0f, kDown}));
+    Rig rig(scene, pipeline);
+    // Straight under it: radiance = albedo / π × I / d² (d = 1.5 m, cos 1), within the
+    // half floats of hdr (1e-3) and the floor's albedo read as composite read it.
+    const glm::vec3 centre(0.0f, -1.0f, 0.0f);
+    const glm::vec4 albedo = rig.at("gbuffer", "albedo", centre);
+    const glm::vec4 radiance = rig.at("composite", "hdr", centre);
+    const float expected = albedo.r / 3.14159265f * 6.0f / (1.5f * 1.5f);
+    INFO("radiance " << radiance.r << ", closed form " << expected);
+    CHECK(std::abs(radiance.r - expected) < 0.01f * expected);
+    // Along +x on the floor: lit inside atan(r / 1.5) < 29°, dark beyond 30°. The edge
+    // (half the light inside) lies between r = 1.5 tan 29° = 0.831 and 1.5 tan 30° = 0.866;
+    // a pixel spans about 0.02 m of floor here.
+    float edge = -1.0f;
+    for (float r = 0.6f; r < 0.98f; r += 0.004f) {
+        const glm::vec3 p(r, -1.0f, 0.0f);
+        const float e = rig.at("composite", "hdr", p).r / std::max(rig.at("gbuffer", "albedo", p).r, 1e-3f);
+        const float inside = radiance.r / albedo.r * (1.5f * 1.5f) / (1.5f * 1.5f + r * r) * 1.5f / std::sqrt(1.5f * 1.5f + r * r);
+        if (e < 0.5f * inside) {
+            edge = r;
+            break;
+        }
+    }
+    INFO("edge at r = " << edge);
+    CHECK(edge > 0.831f - 0.03f);
+    CHECK(edge < 0.866f + 0.03f);
+    // Outside the cone, nothing.
+    CHECK(rig.at("composite", "hdr", {0.95f, -1.0f, 0.0f}).r < 1e-4f);
+}
+
+TEST_CASE("a directional light's shadow falls where its direction casts it", "[gltf][gl]") {
+    // 2 lux along (0, -0.5, -1) / |.|, in through the box's open front (a quaternion of
+    // -26.57° about x turns -z there); a square x, y in [-0.3, 0.3] at z = 0.3 facing the
+    // camera casts itself 1.3 m back and 0.65 m down onto the back wall: y in [-0.95, -0.35].
+    const float half = glm::radians(-26.565f) / 2.0f;
+    nlohmann::json gltf = lightGltf({{"type", "directional"}, {"intensity", 2.0}}, {0.0f, 0.0f, 0.0f},
+                                    {std::sin(half), 0.0f, 0.0f, std::cos(half)});
+    const nlohmann::json plate = squareGltf(0.3f, 0.3f, "", {{"pbrMetallicRoughness", {{"baseColorFactor", {0.8, 0.8, 0.8, 1.0}}}}});
+    for (const char* key : {"meshes", "accessors", "bufferViews", "buffers", "materials"}) gltf[key] = plate[key];
+    gltf["nodes"].push_back({{"mesh", 0}});
+    gltf["scenes"][0]["nodes"] = {0, 1};
+    const auto [scene, pipeline] = directOnly("sun", gltf);
+    Rig rig(scene, pipeline);
+    const glm::vec3 inShadow(0.0f, -0.7f, -1.0f), lit(0.7f, -0.7f, -1.0f);
+    const float shadowed = rig.at("composite", "hdr", inShadow).r;
+    const float litRadiance = rig.at("composite", "hdr", lit).r;
+    // Lit: albedo / π × E × n · l, n = +z (the back wall), n · l = 1 / √1.25.
+    const float expected = rig.at("gbuffer", "albedo", lit).r / 3.14159265f * 2.0f / std::sqrt(1.25f);
+    INFO("in the shadow " << shadowed << ", lit " << litRadiance << ", closed form " << expected);
+    CHECK(shadowed < 1e-4f);
+    CHECK(std::abs(litRadiance - expected) < 0.01f * expected);
 }

@@ -48,6 +48,23 @@ struct alignas(16) GpuInstance {
                          //   w: the alpha cutoff (0: opaque)
 };
 
+// The punctual lights the frame holds at most (glTF's KHR_lights_punctual), and how
+// many of the first of them cast shadows (the `lights` pass's shadow atlas, one tile
+// each); the rest light unshadowed.
+inline constexpr int kMaxPunctualLights = 16;
+inline constexpr int kMaxShadowedLights = 4;
+
+// One punctual light (std140, in GpuFrame). Radiometry as KHR_lights_punctual: a point
+// or spot light's irradiance at distance d is color / d² (times the range window and
+// the cone), a directional light's is color.
+struct GpuPunctualLight {
+    glm::vec4 position;   // xyz world, w = type (0 directional, 1 point, 2 spot)
+    glm::vec4 direction;  // xyz unit, where it shines; w = range (0: infinite)
+    glm::vec4 color;      // rgb × intensity; w = the shadow atlas tile (-1: unshadowed)
+    glm::vec4 cone;       // spot: x cos(outer), y 1 / (cos(inner) − cos(outer)); zw unused
+    glm::mat4 shadowViewProj;  // world → the tile's clip space (orthographic or perspective)
+};
+
 // The per-frame uniform block (std140, binding kFrameBinding); keep in sync with
 // shaders/common/frame.glsl.
 struct GpuFrame {
@@ -63,6 +80,10 @@ struct GpuFrame {
                              //   b, upper radius t, half-angle α (rad), upper centre y_t
     glm::uvec4 boxWalls;     // x: the faces of the box [-1,1]³ that hold a wall, bit 2a for
                              //   −axis a, 2a+1 for +axis a (the open Cornell box: all but +z)
+    glm::vec4 sceneMin;      // the scene's bounds (every instance's, world space); w unused
+    glm::vec4 sceneMax;
+    glm::uvec4 punctualCount;  // x: lights[0 .. x) hold punctual lights
+    GpuPunctualLight punctual[kMaxPunctualLights];
 };
 
 // GpuFrame::boxWalls.x of a box with or without its front wall (z = +1).
