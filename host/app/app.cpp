@@ -59,6 +59,10 @@ bool App::init(const Options& o, std::string& error) {
     if (!runtime_.init(ro, error)) return false;
     runtime_.readEverything = o.headless && !o.dump.empty();  // --dump writes every texture
     if (!scene_.load(o.scene, seedOverride(), error)) return false;
+    // A glTF file given as the scene is seen through its first camera, if it has one.
+    glm::vec3 eye, forward;
+    float fovY = 0.0f;
+    if (scene_.modelCamera(eye, forward, fovY)) camera_.lookFrom(eye, forward, fovY);
     requested_ = requestedTextures();
     runtime_.setRequested(requested_);
     std::string errors;

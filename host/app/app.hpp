@@ -51,8 +51,8 @@ public:
     const Runtime& runtime() const { return runtime_; }
     scene::LiveScene& scene() { return scene_; }
     const scene::LiveScene& scene() const { return scene_; }
-    OrbitCamera& camera() { return camera_; }
-    const OrbitCamera& camera() const { return camera_; }
+    Camera& camera() { return camera_; }
+    const Camera& camera() const { return camera_; }
     LiveReload& live() { return live_; }
     // The seed given on the command line, if any (a scene reload keeps it).
     std::optional<uint64_t> seedOverride() const;
@@ -81,7 +81,7 @@ private:
     Runtime runtime_;
     scene::LiveScene scene_;
     scene::SceneRenderer renderer_;
-    OrbitCamera camera_;
+    Camera camera_;
     LiveReload live_;
     uint64_t frameIndex_ = 0;
     glm::mat4 lastViewProj_{0.0f};

@@ -227,6 +227,7 @@ int runWindow(const Options& o) {
         const Clock::time_point now = Clock::now();
         const double wall = std::chrono::duration<double>(now - last).count();
         last = now;
+        flyFromKeys(window, state, wall);
         state.frameMs = frames == 1 ? wall * 1e3 : state.frameMs * 0.8 + wall * 1e3 * 0.2;
         followBudget(state, std::chrono::duration<double>(now - start).count());
         app.resize(std::max(1, int(std::lround(state.image.z * state.renderScale))),

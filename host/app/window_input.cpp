@@ -75,7 +75,13 @@ void installCallbacks(GLFWwindow* window) {
         WindowState& s = stateOf(w);
         s.uiInput.events.push_back({UiInput::Kind::Scroll, dx, dy});
         if (ImGui::GetIO().WantCaptureMouse) return;
-        s.app->camera().distance = std::clamp(s.app->camera().distance * float(std::pow(0.9, dy)), 1.5f, 10.0f);
+        Camera& camera = s.app->camera();
+        if (camera.mode == Camera::Mode::Fly) {  // a notch: 5 % of the scene's diagonal ahead
+            const auto& scene = s.app->scene();
+            camera.fly(glm::vec3(0.0f, 0.0f, float(dy) * 0.05f * glm::length(scene.boundsMax() - scene.boundsMin())));
+            return;
+        }
+        camera.distance = std::clamp(camera.distance * float(std::pow(0.9, dy)), 1.5f, 10.0f);
     });
     glfwSetCursorPosCallback(window, [](GLFWwindow* w, double x, double y) {
         WindowState& s = stateOf(w);
@@ -107,7 +113,26 @@ void installCallbacks(GLFWwindow* window) {
         if (key == GLFW_KEY_M) s->app->scene().sim().spawnRandom(sim::BallKind::Marble);
         if (key == GLFW_KEY_F) s->app->scene().sim().spawnRandom(sim::BallKind::Fireball);
         if (key == GLFW_KEY_R) s->app->scene().reset();
+        if (key == GLFW_KEY_C) {  // orbit ↔ fly
+            Camera& c = s->app->camera();
+            if (c.mode == Camera::Mode::Orbit) c.toFly();
+            else c.toOrbit();
+        }
     });
+}
+
+// W/S forward and back, A/D left and right, Q/E down and up (Shift: 4× as fast) at a
+// quarter of the scene's diagonal a second: the camera flies from where it is.
+void flyFromKeys(GLFWwindow* window, WindowState& state, double seconds) {
+    if (ImGui::GetIO().WantCaptureKeyboard) return;
+    auto down = [&](int key) { return glfwGetKey(window, key) == GLFW_PRESS ? 1.0f : 0.0f; };
+    const glm::vec3 move(down(GLFW_KEY_D) - down(GLFW_KEY_A), down(GLFW_KEY_E) - down(GLFW_KEY_Q),
+                         down(GLFW_KEY_W) - down(GLFW_KEY_S));
+    if (move == glm::vec3(0.0f)) return;
+    const auto& scene = state.app->scene();
+    const float speed = 0.25f * glm::length(scene.boundsMax() - scene.boundsMin()) *
+                        (down(GLFW_KEY_LEFT_SHIFT) + down(GLFW_KEY_RIGHT_SHIFT) > 0.0f ? 4.0f : 1.0f);
+    state.app->camera().fly(move * (speed * float(std::min(seconds, 0.1))));
 }
 
 // Right button on the image: trace that pixel through the graph (panelTrace).

@@ -171,6 +171,7 @@ void legendLabels(WindowState&);
 // window_input.cpp: keys, wheel and button events, and the left button's drags.
 void installCallbacks(GLFWwindow*);
 void handleMouse(GLFWwindow*, WindowState&);
+void flyFromKeys(GLFWwindow*, WindowState&, double seconds);
 
 // ui_probe.cpp: what --ui-probe writes each frame, and --screenshot.
 nlohmann::json probeState(const WindowState&, uint64_t frame);

@@ -158,6 +158,16 @@ void LiveScene::placeModels(std::vector<PlacedModel> models) {
         log::warn(file_, ": ", lights_.size(), " punctual lights; the first ", kMaxPunctualLights, " are drawn");
 }
 
+bool LiveScene::modelCamera(glm::vec3& eye, glm::vec3& forward, float& fovY) const {
+    if (!isGltfFile(file_) || models_.empty() || models_[0].model->cameras.empty()) return false;
+    const model::Camera& c = models_[0].model->cameras[0];
+    const glm::mat4 world = models_[0].placement * c.transform;
+    eye = glm::vec3(world[3]);
+    forward = glm::normalize(-glm::vec3(world[2]));
+    fovY = c.yfov;
+    return true;
+}
+
 std::vector<std::string> LiveScene::modelFiles() const {
     std::vector<std::string> files;
     for (const PlacedModel& p : models_) files.insert(files.end(), p.model->files.begin(), p.model->files.end());

@@ -29,6 +29,10 @@ public:
     // The placed models' punctual lights in world space. A model placed at scale s has its
     // point and spot lights' intensity × s², so it is lit as its file shows it.
     const std::vector<model::Light>& lights() const { return lights_; }
+    // A glTF scene file's first camera, placed as its model is: where it is, where it
+    // looks and its vertical field of view. False for a scene file (JSON: the box's view)
+    // or a model without cameras.
+    bool modelCamera(glm::vec3& eye, glm::vec3& forward, float& fovY) const;
     // The scene's bounds: the box's and the placed models'.
     glm::vec3 boundsMin() const { return boundsMin_; }
     glm::vec3 boundsMax() const { return boundsMax_; }

@@ -7,6 +7,8 @@
 #include <filesystem>
 #include <fstream>
 
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/quaternion.hpp>
 #include <nlohmann/json.hpp>
 
 #include "app/app.hpp"
@@ -333,4 +335,59 @@ TEST_CASE("a directional light's shadow falls where its direction casts it", "[g
     INFO("in the shadow " << shadowed << ", lit " << litRadiance << ", closed form " << expected);
     CHECK(shadowed < 1e-4f);
     CHECK(std::abs(litRadiance - expected) < 0.01f * expected);
+}
+
+TEST_CASE("kiln --scene model.gltf looks through the file's first camera, as the test projects it", "[gltf][gl]") {
+    // A big triangle spanning x, z in [-0.8, 0.8] and y in [-1, 0.4], which the box's fit
+    // leaves where it is (scale 1, standing on the floor, centred), and a small red
+    // emissive square centred at m; a camera at e looking at t, fov 0.5 rad.
+    const glm::vec3 m(0.3f, -0.2f, -0.5f), e(0.5f, 0.3f, 2.5f), t(0.0f, -0.2f, 0.0f);
+    const float fov = 0.5f, h = 0.02f;
+    const std::vector<float> pos = {-0.8f, -1.0f, -0.8f, 0.8f, -1.0f, 0.8f, 0.8f, 0.4f, -0.8f,
+                                    m.x - h, m.y - h, m.z, m.x + h, m.y - h, m.z, m.x + h, m.y + h, m.z,
+                                    m.x - h, m.y - h, m.z, m.x + h, m.y + h, m.z, m.x - h, m.y + h, m.z};
+    std::vector<uint8_t> bin(reinterpret_cast<const uint8_t*>(pos.data()),
+                             reinterpret_cast<const uint8_t*>(pos.data()) + pos.size() * 4);
+    // The camera's node: its rotation is the view's frame (x right, y up, z back).
+    const glm::vec3 back = glm::normalize(e - t), right = glm::normalize(glm::cross(glm::vec3(0, 1, 0), back));
+    const glm::quat q = glm::quat_cast(glm::mat3(right, glm::cross(back, right), back));
+    const nlohmann::json gltf = {
+        {"asset", {{"version", "2.0"}}}, {"scene", 0}, {"scenes", {{{"nodes", {0, 1, 2}}}}},
+        {"nodes", {{{"mesh", 0}}, {{"mesh", 1}},
+                   {{"camera", 0}, {"translation", {e.x, e.y, e.z}}, {"rotation", {q.x, q.y, q.z, q.w}}}}},
+        {"cameras", {{{"type", "perspective"}, {"perspective", {{"yfov", fov}, {"znear", 0.05}}}}}},
+        {"meshes", {{{"primitives", {{{"attributes", {{"POSITION", 0}}}}}}},
+                    {{"primitives", {{{"attributes", {{"POSITION", 1}}}, {"material", 0}}}}}}},
+        {"materials", {{{"emissiveFactor", {1.0, 0.0, 0.0}}, {"pbrMetallicRoughness", {{"baseColorFactor", {0, 0, 0, 1}}}}}}},
+        {"accessors", {{{"bufferView", 0}, {"componentType", 5126}, {"count", 3}, {"type", "VEC3"}},
+                       {{"bufferView", 0}, {"byteOffset", 36}, {"componentType", 5126}, {"count", 6}, {"type", "VEC3"}}}},
+        {"bufferViews", {{{"buffer", 0}, {"byteLength", bin.size()}}}},
+        {"buffers", {{{"byteLength", bin.size()}, {"uri", "data:application/octet-stream;base64," + base64(bin)}}}}};
+    const fs::path dir = fs::path(TEST_OUTPUT_DIR) / "gltf";
+    fs::create_directories(dir);
+    std::ofstream(dir / "camera.gltf") << gltf.dump();
+    REQUIRE(test::ensureHeadlessContext());
+    app::Options o = test::pausedHeadlessOptions(kSize);
+    o.scene = (dir / "camera.gltf").string();
+    app::App app;
+    std::string error;
+    INFO(error);
+    REQUIRE(app.init(o, error));
+    app.frame();
+    // Where the marker lands by the test's own projection (GL: row 0 at the bottom).
+    const glm::mat4 vp = glm::perspective(fov, 1.0f, 0.05f, 20.0f) * glm::lookAt(e, t, glm::vec3(0, 1, 0));
+    const glm::vec4 c = vp * glm::vec4(m, 1.0f);
+    const glm::vec2 expected = (glm::vec2(c) / c.w * 0.5f + 0.5f) * float(kSize);
+    // Where it is: the centroid of the red emission.
+    const FloatImage img = test::readOutput(app, "gbuffer", "emissive");
+    glm::dvec2 sum(0.0);
+    int n = 0;
+    for (int y = 0; y < img.height; ++y)
+        for (int x = 0; x < img.width; ++x)
+            if (img.at(x, y)[0] > 0.5f && img.at(x, y)[1] < 0.1f) sum += glm::dvec2(x + 0.5, y + 0.5), ++n;
+    REQUIRE(n > 0);
+    const glm::vec2 found = glm::vec2(sum / double(n));
+    INFO("expected " << expected.x << ", " << expected.y << "; found " << found.x << ", " << found.y << " (" << n << " px)");
+    // The square spans a few pixels; its centroid within a pixel of the projection.
+    CHECK(glm::length(found - expected) < 1.0f);
 }

@@ -35,7 +35,7 @@ TEST_CASE("a moved ball's region holds every point of the room its shadow falls 
     // Independent of the cone construction: points of the room (on its walls and
     // inside it) are tested for a segment to any of 96 points of the lamp's ball that
     // passes through the ball; each such point must project inside the region.
-    app::OrbitCamera camera;
+    app::Camera camera;
     scene::RedrawView view;
     view.viewProj = camera.projection(1.0f) * camera.view();
     view.width = view.height = 400;
