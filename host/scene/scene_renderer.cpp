@@ -149,24 +149,22 @@ void SceneRenderer::buildMeshes() {
         vao_ = gl::createVertexArray();
         const GLuint vao = vao_.id();
         gl::label(GL_VERTEX_ARRAY, vao, "scene.vao");
-        glEnableVertexArrayAttrib(vao, 0);
-        glEnableVertexArrayAttrib(vao, 1);
-        glVertexArrayAttribFormat(vao, 0, 3, GL_FLOAT, GL_FALSE, offsetof(Vertex, position));
-        glVertexArrayAttribFormat(vao, 1, 3, GL_FLOAT, GL_FALSE, offsetof(Vertex, normal));
-        glVertexArrayAttribBinding(vao, 0, 0);
-        glVertexArrayAttribBinding(vao, 1, 0);
+        // Attribute, components, offset, buffer binding: positions and normals (0),
+        // the instance index (1, per instance), texture coordinates and tangents in a
+        // stream of their own (2), so a vertex shader that does not read them fetches
+        // nothing more than before.
+        const struct { GLuint attribute; GLint components; GLuint offset; GLuint binding; } attributes[] = {
+            {0, 3, offsetof(Vertex, position), 0}, {1, 3, offsetof(Vertex, normal), 0},
+            {3, 2, offsetof(SurfaceVertex, uv), 2}, {4, 4, offsetof(SurfaceVertex, tangent), 2}};
+        for (const auto& a : attributes) {
+            glEnableVertexArrayAttrib(vao, a.attribute);
+            glVertexArrayAttribFormat(vao, a.attribute, a.components, GL_FLOAT, GL_FALSE, a.offset);
+            glVertexArrayAttribBinding(vao, a.attribute, a.binding);
+        }
         glEnableVertexArrayAttrib(vao, 2);
         glVertexArrayAttribIFormat(vao, 2, 1, GL_UNSIGNED_INT, 0);
         glVertexArrayAttribBinding(vao, 2, 1);
         glVertexArrayBindingDivisor(vao, 1, 1);
-        // Texture coordinates and tangents in a stream of their own: a vertex shader that
-        // does not read them fetches nothing more than before.
-        glEnableVertexArrayAttrib(vao, 3);
-        glEnableVertexArrayAttrib(vao, 4);
-        glVertexArrayAttribFormat(vao, 3, 2, GL_FLOAT, GL_FALSE, offsetof(SurfaceVertex, uv));
-        glVertexArrayAttribFormat(vao, 4, 4, GL_FLOAT, GL_FALSE, offsetof(SurfaceVertex, tangent));
-        glVertexArrayAttribBinding(vao, 3, 2);
-        glVertexArrayAttribBinding(vao, 4, 2);
     }
     glVertexArrayVertexBuffer(vao_.id(), 0, vertexBuffer_.id(), 0, sizeof(Vertex));
     glVertexArrayVertexBuffer(vao_.id(), 2, surfaceBuffer_.id(), 0, sizeof(SurfaceVertex));

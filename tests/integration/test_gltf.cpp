@@ -15,6 +15,7 @@
 #include "kiln/image_io.hpp"
 #include "support/headless.hpp"
 #include "support/run_kiln.hpp"
+#include "support/base64.hpp"
 
 namespace fs = std::filesystem;
 using namespace kiln;
@@ -23,20 +24,7 @@ namespace {
 
 constexpr int kSize = 160;
 
-std::string base64(const std::vector<uint8_t>& bytes) {
-    static const char* table = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    std::string out;
-    for (size_t i = 0; i < bytes.size(); i += 3) {
-        uint32_t v = uint32_t(bytes[i]) << 16;
-        if (i + 1 < bytes.size()) v |= uint32_t(bytes[i + 1]) << 8;
-        if (i + 2 < bytes.size()) v |= bytes[i + 2];
-        out += table[(v >> 18) & 63];
-        out += table[(v >> 12) & 63];
-        out += i + 1 < bytes.size() ? table[(v >> 6) & 63] : '=';
-        out += i + 2 < bytes.size() ? table[v & 63] : '=';
-    }
-    return out;
-}
+using kiln::test::base64;
 
 // A 64×64 PNG whose four quadrants (as the image is seen, top row first) have the
 // colours given: top-left, top-right, bottom-left, bottom-right (RGBA, 0..1).
@@ -226,17 +214,28 @@ TEST_CASE("kiln --scene renders assimp-testmodels' 2CylinderEngine.glb and names
     const std::string models = "/usr/share/assimp/models/glTF2";
     const fs::path out = fs::path(TEST_OUTPUT_DIR) / "gltf" / "engine.png";
     fs::create_directories(out.parent_path());
-    const auto ok = test::runKiln("--headless --size 96x96 --frames 2 --scene " + models +
-                                  "/2CylinderEngine-glTF-Binary/2CylinderEngine.glb --out " + out.string());
+    // Placed by a scene file (fitted into the box, seen through the box's camera) ...
+    const fs::path scene = out.parent_path() / "engine.json";
+    std::ofstream(scene) << R"({"tumblers": [], "models": [{"file": ")" << models
+                         << R"(/2CylinderEngine-glTF-Binary/2CylinderEngine.glb", "fit": true}]})";
+    const auto ok = test::runKiln("--headless --size 96x96 --frames 2 --scene " + scene.string() + " --out " + out.string());
     INFO(ok.out << ok.err);
     REQUIRE(ok.exitCode == 0);
     FloatImage img;
     std::string error;
     REQUIRE(readPng(out.string(), img, error));
-    // The engine stands in the middle of the box: the centre pixel is no wall's colour
-    // and not black.
+    // The engine stands in the middle of the box: the centre pixel is neither black nor
+    // the back wall's colour.
     const float* centre = img.at(48, 40);
+    INFO(centre[0] << " " << centre[1] << " " << centre[2]);
     CHECK(centre[0] + centre[1] + centre[2] > 0.02f);
+    // ... and given as the scene (through its own camera).
+    const fs::path alone = out.parent_path() / "engine_alone.png";
+    const auto direct = test::runKiln("--headless --size 64x64 --frames 1 --scene " + models +
+                                      "/2CylinderEngine-glTF-Binary/2CylinderEngine.glb --out " + alone.string());
+    INFO(direct.out << direct.err);
+    CHECK(direct.exitCode == 0);
+    CHECK(fs::exists(alone));
     const auto bad = test::runKiln("--headless --size 32x32 --frames 1 --scene " + models +
                                    "/IndexOutOfRange/IndexOutOfRange.gltf --out " + out.string());
     INFO(bad.out << bad.err);

@@ -2,6 +2,7 @@
 // project's shaders, pipelines and scene. Waits poll frames with a generous timeout
 // and assert behaviour, never speed.
 #include "live/sandbox.hpp"
+#include "support/base64.hpp"
 #include "support/faults.hpp"
 
 namespace fs = std::filesystem;
@@ -265,16 +266,7 @@ std::string squareGltf(const char* rgb, int lastIndex = 3) {
     const float p[12] = {-0.6f, -0.6f, 0, 0.6f, -0.6f, 0, 0.6f, 0.6f, 0, -0.6f, 0.6f, 0};
     std::vector<uint8_t> bin(reinterpret_cast<const uint8_t*>(p), reinterpret_cast<const uint8_t*>(p) + 48);
     for (int i : {0, 1, 2, 0, 2, lastIndex}) bin.push_back(uint8_t(i));
-    static const char* table = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    std::string b64;
-    for (size_t i = 0; i < bin.size(); i += 3) {
-        uint32_t v = uint32_t(bin[i]) << 16 | uint32_t(i + 1 < bin.size() ? bin[i + 1] : 0) << 8 |
-                     (i + 2 < bin.size() ? bin[i + 2] : 0);
-        b64 += table[(v >> 18) & 63];
-        b64 += table[(v >> 12) & 63];
-        b64 += i + 1 < bin.size() ? table[(v >> 6) & 63] : '=';
-        b64 += i + 2 < bin.size() ? table[v & 63] : '=';
-    }
+    const std::string b64 = base64(bin);
     return std::string(R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
       "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "material": 0}]}],
       "materials": [{"pbrMetallicRoughness": {"baseColorFactor": [)") + rgb + R"(, 1]}}],

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "model/model.hpp"
+#include "support/base64.hpp"
 
 using kiln::model::Model;
 namespace fs = std::filesystem;
@@ -26,20 +27,7 @@ std::string loadError(const std::string& path) {
     return error;
 }
 
-std::string base64(const std::vector<uint8_t>& bytes) {
-    static const char* table = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    std::string out;
-    for (size_t i = 0; i < bytes.size(); i += 3) {
-        uint32_t v = uint32_t(bytes[i]) << 16;
-        if (i + 1 < bytes.size()) v |= uint32_t(bytes[i + 1]) << 8;
-        if (i + 2 < bytes.size()) v |= bytes[i + 2];
-        out += table[(v >> 18) & 63];
-        out += table[(v >> 12) & 63];
-        out += i + 1 < bytes.size() ? table[(v >> 6) & 63] : '=';
-        out += i + 2 < bytes.size() ? table[v & 63] : '=';
-    }
-    return out;
-}
+using kiln::test::base64;
 
 // A glTF written by the test: one buffer (a data URI) that views and accessors append to.
 struct Writer {
