@@ -1,5 +1,6 @@
-// shadow — depth of the shadow casters (tumblers, marbles; fireballs emit, they don't
-// cast) seen from the lamp, one perspective 2D map (projection in common/shadow.glsl).
+// shadow — depth of the shadow casters (tumblers, marbles and the placed meshes;
+// fireballs emit, they don't cast) seen from the lamp, one perspective 2D map
+// (projection in common/shadow.glsl).
 // It reads only the casters and the light, so the host skips it while they are still
 // (a flying fireball alone changes nothing here).
 #include <kiln/pass.hpp>
@@ -42,19 +43,77 @@ public:
 
     void execute(kiln::PassContext& ctx) override {
         GLuint program = ctx.program({.stages = {"shadow/shadow.vert", "shadow/shadow.frag"}});
-        if (!program || !ctx.framebuffer({}, "depth")) return;
-        const float one = 1.0f;
-        glClearBufferfv(GL_DEPTH, 0, &one);
+        if (!program) return;
+        const kiln::SceneView& scene = ctx.scene();
+        const bool meshes = scene.count(kiln::kSceneMeshes) > 0;
+        if (meshes && !drawStaticMeshes(ctx, program)) return;
+        if (!ctx.framebuffer({}, "depth")) return;
+        const kiln::TextureRef& depth = ctx.output("depth");
+        if (meshes) {
+            // The placed meshes do not move: drawn once into the pass's own map (again
+            // when they, the light, the size or the program change), copied under the
+            // moving casters each run.
+            glCopyImageSubData(staticDepth_.id(), GL_TEXTURE_2D, 0, 0, 0, 0, depth.id, GL_TEXTURE_2D, 0, 0, 0, 0,
+                               depth.width, depth.height, 1);
+        } else {
+            const float one = 1.0f;
+            glClearBufferfv(GL_DEPTH, 0, &one);
+        }
         // No caster: the cleared map (everything lit) is the answer.
-        if (ctx.scene().count(kiln::kSceneShadowCasters | kiln::kSceneMeshes) == 0) return;
+        if (scene.count(kiln::kSceneShadowCasters) == 0) return;
+        beginCasters(ctx, program);
+        ctx.drawScene({.categories = kiln::kSceneShadowCasters, .lod = casterLod(ctx)});
+    }
+
+private:
+    static void beginCasters(kiln::PassContext& ctx, GLuint program) {
         glEnable(GL_DEPTH_TEST);
         glDepthFunc(GL_LESS);
         glEnable(GL_POLYGON_OFFSET_FILL);
         glPolygonOffset(ctx.getFloat("slope_bias"), 4.0f);
         glUseProgram(program);
-        // The placed meshes cast at every level (they have one mesh each).
-        ctx.drawScene({.categories = kiln::kSceneShadowCasters | kiln::kSceneMeshes, .lod = casterLod(ctx)});
     }
+
+    // The placed meshes' depth from the lamp in staticDepth_, when what it depends on
+    // changed. False when the pass failed.
+    bool drawStaticMeshes(kiln::PassContext& ctx, GLuint program) {
+        const kiln::SceneView& scene = ctx.scene();
+        const int side = ctx.getInt("size");
+        const StaticKey key{scene.version(kiln::kSceneMeshes), scene.version(kiln::kSceneLight), program, side,
+                            ctx.getFloat("slope_bias")};
+        if (key == built_ && staticDepth_) return true;
+        if (!staticDepth_ || staticDepth_.width() != side) {
+            staticDepth_ = kiln::gl::Texture::create(GL_TEXTURE_2D, GL_DEPTH_COMPONENT32F, side, side, 1, 1,
+                                                     "shadow.static_meshes");
+            framebuffer_ = kiln::gl::createFramebuffer();
+            glNamedFramebufferTexture(framebuffer_.id(), GL_DEPTH_ATTACHMENT, staticDepth_.id(), 0);
+            glNamedFramebufferDrawBuffer(framebuffer_.id(), GL_NONE);
+            if (glCheckNamedFramebufferStatus(framebuffer_.id(), GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+                ctx.fail("the static meshes' depth map is incomplete as a framebuffer");
+                return false;
+            }
+        }
+        glBindFramebuffer(GL_FRAMEBUFFER, framebuffer_.id());
+        glViewport(0, 0, side, side);
+        const float one = 1.0f;
+        glClearBufferfv(GL_DEPTH, 0, &one);
+        beginCasters(ctx, program);
+        ctx.drawScene({.categories = kiln::kSceneMeshes});
+        built_ = key;
+        return true;
+    }
+
+    struct StaticKey {
+        uint64_t meshes = 0, light = 0;
+        GLuint program = 0;
+        int side = 0;
+        float slopeBias = -1.0f;
+        bool operator==(const StaticKey&) const = default;
+    };
+    // A cache (a module reload starts over): what staticDepth_ was drawn from.
+    StaticKey built_;
+    kiln::gl::Texture staticDepth_;
+    kiln::gl::FramebufferHandle framebuffer_;
 };
 
 }  // namespace

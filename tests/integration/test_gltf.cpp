@@ -207,7 +207,34 @@ TEST_CASE("a glTF model casts the lamp's shadow", "[gltf][gl]") {
     INFO("under " << under.r << ", beside " << beside.r);
     CHECK(beside.r > 0.05f);
     CHECK(under.r < 0.02f * beside.r);
+}
 
+TEST_CASE("a glTF model keeps its shadow while the bodies move the shadow map", "[gltf][gl]") {
+    // The plate as above, and a marble flying about the box: the shadow pass runs again
+    // each frame the marble moves, drawing it over the plate's depth it keeps (drawn
+    // once): the plate's shadow stays.
+    nlohmann::json gltf = squareGltf(0.3f, 0.0f, "", {{"pbrMetallicRoughness", {{"baseColorFactor", {0.8, 0.8, 0.8, 1.0}}}}});
+    gltf["nodes"][0]["translation"] = {0.0, -0.5, 0.2};
+    gltf["nodes"][0]["rotation"] = {-std::sqrt(0.5), 0.0, 0.0, std::sqrt(0.5)};
+    const fs::path dir = fs::path(TEST_OUTPUT_DIR) / "gltf";
+    fs::create_directories(dir);
+    std::ofstream(dir / "plate_moving.gltf") << gltf.dump();
+    const fs::path scene = dir / "plate_moving.json";
+    std::ofstream(scene) << R"({"tumblers": [], "models": [{"file": "plate_moving.gltf"}],
+        "marbles": [{"position": [-0.6, 0.5, -0.6], "velocity": [1.5, 0.3, 0.9], "radius": 0.05}]})";
+    Rig rig(scene.string());
+    rig.app.paused = false;
+    rig.app.runtime().resetTimings();
+    for (int i = 0; i < 6; ++i) rig.app.frame();
+    int shadowRuns = 0;
+    for (auto& row : rig.app.runtime().stats())
+        if (row.id == "shadow") shadowRuns = row.ranFrames;
+    CHECK(shadowRuns >= 5);
+    const glm::vec4 under = rig.at("composite", "direct", {0.0f, -1.0f, 0.2f});
+    const glm::vec4 beside = rig.at("composite", "direct", {0.7f, -1.0f, 0.6f});
+    INFO("under " << under.r << ", beside " << beside.r);
+    CHECK(beside.r > 0.05f);
+    CHECK(under.r < 0.02f * beside.r);
 }
 
 TEST_CASE("kiln --scene renders assimp-testmodels' 2CylinderEngine.glb and names a broken glTF", "[gltf][gl]") {
