@@ -113,6 +113,9 @@ void SceneRenderer::buildMeshes() {
         }
         return uint32_t(meshes_.size() - 1);
     };
+    auto twoSided = [](const model::Model& mdl, int material) {
+        return material >= 0 && mdl.materials[size_t(material)].doubleSided;
+    };
     uint32_t materialBase = 0;
     for (const PlacedModel& placed : models_) {
         const model::Model& mdl = *placed.model;
@@ -126,14 +129,14 @@ void SceneRenderer::buildMeshes() {
                 byMesh[size_t(inst.mesh)].push_back(world);
             } else {
                 const uint32_t baked = addMesh(mdl.meshes[size_t(inst.mesh)], &world);
-                meshGroups_.push_back({baked, 1});
+                meshGroups_.push_back({baked, 1, twoSided(mdl, mdl.meshes[size_t(inst.mesh)].material)});
                 meshInstances_.push_back(materialInstance(mdl, materialBase, mdl.meshes[size_t(inst.mesh)].material,
                                                           glm::mat4(1.0f)));
             }
         }
         for (size_t m = 0; m < byMesh.size(); ++m) {
             if (byMesh[m].empty()) continue;
-            meshGroups_.push_back({first + uint32_t(m), uint32_t(byMesh[m].size())});
+            meshGroups_.push_back({first + uint32_t(m), uint32_t(byMesh[m].size()), twoSided(mdl, mdl.meshes[m].material)});
             for (const glm::mat4& world : byMesh[m])
                 meshInstances_.push_back(materialInstance(mdl, materialBase, mdl.meshes[m].material, world));
         }
@@ -453,9 +456,9 @@ void SceneRenderer::rebuildGroups() {
     // far), particles.
     add(kQuad, kSceneBox);
     add(kLamp, kSceneLamp);
-    for (const auto& [mesh, n] : meshGroups_) {
-        groups_.push_back({mesh, kSceneMeshes, Lod::High, true, cursor, n});
-        cursor += n;
+    for (const MeshGroup& g : meshGroups_) {
+        groups_.push_back({g.mesh, kSceneMeshes, Lod::High, true, cursor, g.instances, g.twoSided});
+        cursor += g.instances;
     }
     if (const uint32_t n = count(kSceneTumblers); n > 0) {
         const MeshId camera = tumblersNear_ ? kTumblerNearMesh : kTumblerFarMesh;
@@ -508,7 +511,10 @@ void SceneRenderer::bindInstances() const {
 template <class Visit>
 void SceneRenderer::forEachGroupDrawn(const DrawFilter& filter, Visit visit) const {
     for (auto& g : groups_)
-        if ((filter.categories & g.category) && (g.anyLod || g.lod == filter.lod)) visit(g);
+        if ((filter.categories & g.category) && (g.anyLod || g.lod == filter.lod) &&
+            (g.category != kSceneMeshes || filter.sides == Sides::Any ||
+             g.twoSided == (filter.sides == Sides::TwoSided)))
+            visit(g);
 }
 
 uint64_t SceneRenderer::triangles(const DrawFilter& filter) const {

@@ -136,7 +136,14 @@ private:
         kSphereHigh, kSphereMid, kSphereLow, kParticle, kMeshCount
     };
     struct MeshRange { uint32_t firstIndex = 0, indexCount = 0, baseVertex = 0; };
-    struct Group { uint32_t mesh; SceneCategory category; Lod lod; bool anyLod; uint32_t first, count; };
+    struct Group {
+        uint32_t mesh;
+        SceneCategory category;
+        Lod lod;
+        bool anyLod;
+        uint32_t first, count;
+        bool twoSided = false;  // kSceneMeshes: the material's doubleSided
+    };
     // Calls visit(group) for each group draw() issues for the filter.
     template <class Visit>
     void forEachGroupDrawn(const DrawFilter&, Visit visit) const;
@@ -167,10 +174,10 @@ private:
     std::vector<MeshRange> meshes_;
     SceneLook look_;
     std::vector<PlacedModel> models_;
-    // Per placed model mesh (in models_ order): its first mesh in meshes_; the instances
-    // of kSceneMeshes, grouped by mesh (meshInstanceCounts_ each).
+    // The instances of kSceneMeshes, grouped by mesh (meshGroups_ in order).
     std::vector<GpuInstance> meshInstances_;
-    std::vector<std::pair<uint32_t, uint32_t>> meshGroups_;  // (mesh, instances)
+    struct MeshGroup { uint32_t mesh, instances; bool twoSided; };
+    std::vector<MeshGroup> meshGroups_;
     gl::Buffer vertexBuffer_, surfaceBuffer_, indexBuffer_;
     gl::TextureHandle colorLayers_, dataLayers_;
     gl::VertexArrayHandle vao_;

@@ -100,12 +100,16 @@ public:
             glDisable(GL_CULL_FACE);
             if (tracedSpheres) drawTracedSpheres(ctx, sphereProgram);
             if (meshes) {
-                // Either side may show (a glTF surface is open or double-sided): the back
-                // face's normal is turned to the viewer, as the walls' are.
+                // One-sided materials with their back faces culled (glTF's default: no
+                // setup for half the triangles); double-sided ones show either side, the
+                // back face's normal turned to the viewer, as the walls' are.
                 glUseProgram(texturedProgram);
                 kiln::gl::bindTexture(texturedProgram, "u_colorLayers", scene.materialTextures[0]);
                 kiln::gl::bindTexture(texturedProgram, "u_dataLayers", scene.materialTextures[1]);
-                ctx.drawScene({.categories = kiln::kSceneMeshes});
+                glEnable(GL_CULL_FACE);
+                ctx.drawScene({.categories = kiln::kSceneMeshes, .sides = kiln::Sides::OneSided});
+                glDisable(GL_CULL_FACE);
+                ctx.drawScene({.categories = kiln::kSceneMeshes, .sides = kiln::Sides::TwoSided});
             }
             glUseProgram(program);
             ctx.drawScene({.categories = kiln::kSceneStatic});

@@ -24,9 +24,15 @@ enum class Lod : uint8_t { High, Low, Medium, Fine };
 
 // What drawScene() draws: the geometry bits of SceneCategory (kSceneGeometry,
 // kSceneShadowCasters, kSceneTumblers | kSceneMarbles, ...) at a level of detail.
+// Which of the placed meshes (kSceneMeshes) by their material's sides: one-sided ones
+// may be drawn with back faces culled, double-sided ones not. Other categories are
+// drawn whatever it says.
+enum class Sides : uint8_t { Any, OneSided, TwoSided };
+
 struct DrawFilter {
     uint32_t categories = kSceneGeometry;
     Lod lod = Lod::High;
+    Sides sides = Sides::Any;
 };
 
 // Per-instance data as the shaders see it (std430, binding kInstanceBinding); keep in
