@@ -30,7 +30,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     std::string error;
     if (!loadGltfFromMemory("fuzz.gltf", data, size, "", m, error, limits)) {
         require(!error.empty(), "a failed load with no error");
-        require(error.size() <= 1200, "an error message longer than 1200 bytes", error);
+        require(error.size() <= 700, "an error message longer than 700 bytes", error);
         require(error.find('\n') == std::string::npos, "an error message of several lines", error);
         require(error.rfind("fuzz.gltf: ", 0) == 0, "an error that does not name the file", error);
         return 0;

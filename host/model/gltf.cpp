@@ -18,6 +18,7 @@
 #include <sys/stat.h>
 #include <tiny_gltf.h>
 
+#include "kiln/json_text.hpp"
 #include "model/gltf_schema.hpp"
 #include "model/model.hpp"
 
@@ -898,8 +899,11 @@ std::string oneLine(std::string s) {
 
 bool loadGltfFromMemory(const std::string& name, const uint8_t* bytes, size_t size, const std::string& baseDir,
                         Model& out, std::string& error, const Limits& limits) {
+    // One line of bounded length: a path or a message may quote what the file holds.
     auto say = [&](const std::string& path, const std::string& message) {
-        error = name + ": " + (path.empty() ? "" : path + ": ") + message;
+        error = name + ": " + (path.empty() ? "" : json_text::elide(path, 200) + ": ") + json_text::elide(message, 400);
+        for (char& c : error)
+            if (c == '\n' || c == '\r') c = ' ';
         return false;
     };
     if (size > limits.fileBytes)
@@ -910,7 +914,15 @@ bool loadGltfFromMemory(const std::string& name, const uint8_t* bytes, size_t si
     nlohmann::json root;
     try {
         root = nlohmann::json::parse(json);
-    } catch (const nlohmann::json::exception& e) {  // its message says where (the byte)
+    } catch (const nlohmann::json::parse_error& e) {
+        // nlohmann's message quotes all it read of the bad token: the line and column say where.
+        int line = 1, column = 1;
+        json_text::lineColumn(json, e.byte > 0 ? e.byte - 1 : 0, line, column);
+        std::string what = e.what();
+        if (const size_t cut = what.find("; last read"); cut != std::string::npos) what.resize(cut);
+        if (const size_t colon = what.find(": syntax error"); colon != std::string::npos) what = what.substr(colon + 2);
+        return say("", "not valid JSON: line " + std::to_string(line) + ", column " + std::to_string(column) + ": " + what);
+    } catch (const nlohmann::json::exception& e) {
         return say("", std::string("not valid JSON: ") + e.what());
     }
     SchemaError schema;
