@@ -128,7 +128,7 @@ SceneView App::buildView() {
     v.frame.woodDark = glm::vec4(look.woodDark, 0.0f);
     v.frame.tumblerShape = glm::vec4(look.tumblerB, look.tumblerT, look.tumblerAlpha,
                                      (look.tumblerB - look.tumblerT) / std::sin(look.tumblerAlpha));
-    v.frame.boxWalls = glm::uvec4(boxWallBits(look.closed), 0u, 0u, 0u);
+    v.frame.boxWalls = glm::uvec4(look.walls ? boxWallBits(look.closed) : 0u, 0u, 0u, 0u);
     v.frame.sceneMin = glm::vec4(scene_.boundsMin(), 0.0f);
     v.frame.sceneMax = glm::vec4(scene_.boundsMax(), 0.0f);
     scene::packPunctualLights(scene_.lights(), scene_.boundsMin(), scene_.boundsMax(), v.frame);

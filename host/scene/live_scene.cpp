@@ -23,10 +23,11 @@ SceneLook lookOf(const sim::Scene& scene) {
     look.woodRingFrequency = float(scene.box.floorWood.ringFrequency);
     look.wallEmission = glm::vec3(scene.box.emission);
     look.closed = scene.box.closed;
+    look.walls = scene.box.walls;
     look.lampCentre = glm::vec3(scene.lamp.center);
     look.lampRadius = float(scene.lamp.radius);
     look.lampColor = glm::vec3(scene.lamp.color);
-    look.lampIntensity = float(scene.lamp.intensity);
+    look.lampIntensity = scene.box.walls ? float(scene.lamp.intensity) : 0.0f;  // the lamp goes with the box
     look.tumblerB = float(scene.tumblerShape.b);
     look.tumblerT = float(scene.tumblerShape.t);
     look.tumblerAlpha = float(scene.tumblerShape.alpha);
@@ -64,11 +65,16 @@ bool isGltfFile(const std::string& path) {
 }
 
 // Where a model spec puts the model: translate × rotate (x, then y, then z) × scale,
-// after the fit into the box when it asks for one (its bounds on the floor, centred,
-// within x, z ∈ [-0.8, 0.8] and 1.4 high, under the lamp).
-glm::mat4 placementOf(const sim::Scene::ModelSpec& spec, const model::Model& m) {
+// after the fit when it asks for one: in the box, its bounds on the floor, centred,
+// within x, z ∈ [-0.8, 0.8] and 1.4 high, under the lamp; without walls, centred in
+// [-0.9, 0.9]³.
+glm::mat4 placementOf(const sim::Scene::ModelSpec& spec, const model::Model& m, bool walls) {
     glm::mat4 fit(1.0f);
-    if (spec.fit) {
+    if (spec.fit && !walls) {
+        const glm::vec3 extent = glm::max(m.boundsMax - m.boundsMin, glm::vec3(1e-6f));
+        const float s = 1.8f / std::max({extent.x, extent.y, extent.z});
+        fit = glm::scale(glm::mat4(1.0f), glm::vec3(s)) * glm::translate(glm::mat4(1.0f), -0.5f * (m.boundsMin + m.boundsMax));
+    } else if (spec.fit) {
         const glm::vec3 extent = glm::max(m.boundsMax - m.boundsMin, glm::vec3(1e-6f));
         const float s = std::min({1.6f / extent.x, 1.4f / extent.y, 1.6f / extent.z});
         const glm::vec3 base(0.5f * (m.boundsMin.x + m.boundsMax.x), m.boundsMin.y, 0.5f * (m.boundsMin.z + m.boundsMax.z));
@@ -100,7 +106,7 @@ bool LiveScene::loadModels(const sim::Scene& scene, const std::string& sceneFile
             return false;
         }
         for (const std::string& w : m->warnings) log::warn(file.string(), ": ", w);
-        out.push_back({m, placementOf(spec, *m)});
+        out.push_back({m, placementOf(spec, *m, scene.box.walls)});
     }
     return true;
 }
@@ -115,6 +121,12 @@ bool LiveScene::load(const std::string& sceneFile, std::optional<uint64_t> seed,
     }
     std::vector<PlacedModel> models;
     if (!loadModels(scene, sceneFile, models, error)) return false;
+    // A model with lights of its own is shown alone, lit by them; one without stands in
+    // the box under its lamp.
+    if (isGltfFile(sceneFile) && !models[0].model->lights.empty()) {
+        scene.box.walls = false;
+        models[0].placement = placementOf(scene.models[0], *models[0].model, false);
+    }
     if (seed) scene.physics.seed = *seed;
     sim_.reset(scene);
     spec_ = scene;
@@ -136,7 +148,9 @@ void LiveScene::placeModels(std::vector<PlacedModel> models) {
     models_ = std::move(models);
     ++modelsVersion_;
     lights_.clear();
-    boundsMin_ = glm::vec3(-1.0f), boundsMax_ = glm::vec3(1.0f);  // the box
+    // The box's, and the models'.
+    bool any = spec_.box.walls;
+    boundsMin_ = glm::vec3(any ? -1.0f : 0.0f), boundsMax_ = glm::vec3(any ? 1.0f : 0.0f);
     for (const PlacedModel& p : models_) {
         const glm::mat4& m = p.placement;
         const float scale = std::cbrt(std::abs(glm::determinant(glm::mat3(m))));
@@ -151,7 +165,8 @@ void LiveScene::placeModels(std::vector<PlacedModel> models) {
                                    (c & 2) ? p.model->boundsMax.y : p.model->boundsMin.y,
                                    (c & 4) ? p.model->boundsMax.z : p.model->boundsMin.z);
             const glm::vec3 w = glm::vec3(m * glm::vec4(corner, 1.0f));
-            boundsMin_ = glm::min(boundsMin_, w), boundsMax_ = glm::max(boundsMax_, w);
+            boundsMin_ = any ? glm::min(boundsMin_, w) : w, boundsMax_ = any ? glm::max(boundsMax_, w) : w;
+            any = true;
         }
     }
     if (lights_.size() > size_t(kMaxPunctualLights))

@@ -202,23 +202,26 @@ void SceneRenderer::setLook(const SceneLook& look) {
     };
     // The quad faces +y at y = 0; each wall is it rotated so its normal points into the room.
     const glm::mat4 I(1.0f);
-    wall(glm::translate(I, {0, -1, 0}), look.woodLight, 1.0f);                                           // floor
-    wall(glm::rotate(glm::translate(I, {0, 1, 0}), glm::radians(180.0f), {1, 0, 0}), look.other, 0.0f);  // ceiling
-    wall(glm::rotate(glm::translate(I, {-1, 0, 0}), glm::radians(-90.0f), {0, 0, 1}), look.left, 0.0f);  // left
-    wall(glm::rotate(glm::translate(I, {1, 0, 0}), glm::radians(90.0f), {0, 0, 1}), look.right, 0.0f);   // right
-    wall(glm::rotate(glm::translate(I, {0, 0, -1}), glm::radians(90.0f), {1, 0, 0}), look.other, 0.0f);  // back
-    if (look.closed) wall(glm::rotate(glm::translate(I, {0, 0, 1}), glm::radians(-90.0f), {1, 0, 0}), look.other, 0.0f);
+    if (look.walls) {
+        wall(glm::translate(I, {0, -1, 0}), look.woodLight, 1.0f);                                           // floor
+        wall(glm::rotate(glm::translate(I, {0, 1, 0}), glm::radians(180.0f), {1, 0, 0}), look.other, 0.0f);  // ceiling
+        wall(glm::rotate(glm::translate(I, {-1, 0, 0}), glm::radians(-90.0f), {0, 0, 1}), look.left, 0.0f);  // left
+        wall(glm::rotate(glm::translate(I, {1, 0, 0}), glm::radians(90.0f), {0, 0, 1}), look.right, 0.0f);   // right
+        wall(glm::rotate(glm::translate(I, {0, 0, -1}), glm::radians(90.0f), {1, 0, 0}), look.other, 0.0f);  // back
+        if (look.closed) wall(glm::rotate(glm::translate(I, {0, 0, 1}), glm::radians(-90.0f), {1, 0, 0}), look.other, 0.0f);
+    }
     const size_t walls = staticInstances_.size();
     // The lamp dome: its mesh is already in world space.
-    staticInstances_.push_back(
-        {I, glm::vec4(look.lampColor, 0.0f), glm::vec4(look.lampColor * look.lampIntensity, 0.0f)});
+    if (look.walls)
+        staticInstances_.push_back(
+            {I, glm::vec4(look.lampColor, 0.0f), glm::vec4(look.lampColor * look.lampIntensity, 0.0f)});
     // The tumbler's mesh about its origin (the lower ball's centre): the upper ball's top.
     tumblerRadius_ = tumblerBoundingRadius(look.tumblerB, look.tumblerT, look.tumblerAlpha);
     movedUnbounded_ = true;
     // New meshes change what every category looks like, whatever its instances say.
     for (int i = 0; i < kSceneGeometryCount; ++i) ++versions_[i], hashes_[i] = 0;
     noteContents(kSceneBox, staticInstances_.data(), walls);
-    noteContents(kSceneLamp, staticInstances_.data() + walls, 1);
+    noteContents(kSceneLamp, staticInstances_.data() + walls, staticInstances_.size() - walls);
     noteContents(kSceneMeshes, meshInstances_.data(), meshInstances_.size());
     dirty_ = true;
 }

@@ -32,6 +32,7 @@ struct SceneLook {
     float woodRingFrequency = 14.0f;
     glm::vec3 wallEmission{0.0f};  // radiance every wall emits
     bool closed = false;           // a front wall at z = +1 (colour `other`)
+    bool walls = true;             // false: no walls and no lamp dome (a model alone)
     glm::vec3 lampCentre{0.0f, 1.1f, 0.0f};
     float lampRadius = 0.35f;
     glm::vec3 lampColor{1.0f, 0.95f, 0.85f};

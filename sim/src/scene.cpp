@@ -294,7 +294,7 @@ bool readBox(const Json& root, Scene& s, SceneError& error) {
         Reader r{*o, "box", error, {}};
         if (!r.vec<3>("left", s.box.left, 0, 1) || !r.vec<3>("right", s.box.right, 0, 1) ||
             !r.vec<3>("other", s.box.other, 0, 1) || !r.vec<3>("emission", s.box.emission, 0, 1e4) ||
-            !r.boolean("closed", s.box.closed))
+            !r.boolean("closed", s.box.closed) || !r.boolean("walls", s.box.walls))
             return false;
         r.known.insert("floor_wood");
         const Json* w = nullptr;
@@ -470,6 +470,13 @@ static bool readScene(const Json& root, Scene& out, SceneError& error) {
     Reader top{root, "", error,
                {"box", "lamp", "physics", "tumbler_shape", "tumblers", "marbles", "fireballs", "models", "$schema"}};
     if (!top.finish()) return false;
+    // The bodies are the box's: they stand on its floor and bounce off its walls.
+    if (!s.box.walls && (!s.tumblers.empty() || !s.marbles.empty() || !s.fireballs.empty())) {
+        error = {"box.walls", "false, but the scene has " + std::to_string(s.tumblers.size()) + " tumblers, " +
+                                  std::to_string(s.marbles.size()) + " marbles and " + std::to_string(s.fireballs.size()) +
+                                  " fireballs: they live in the box (remove them, or keep the walls)"};
+        return false;
+    }
     out = std::move(s);
     return true;
 }

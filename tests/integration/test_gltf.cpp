@@ -429,3 +429,48 @@ TEST_CASE("kiln --scene model.gltf looks through the file's first camera, as the
     // The square spans a few pixels; its centroid within a pixel of the projection.
     CHECK(glm::length(found - expected) < 1.0f);
 }
+
+TEST_CASE("a scene without walls shows a model alone, lit by its own light", "[gltf][gl]") {
+    // The plate of the shadow tests and a point light 0.5 m above its centre, no walls,
+    // no lamp: where the back wall would be, nothing; the plate lit as I / d² says.
+    nlohmann::json gltf = squareGltf(0.3f, 0.0f, "", {{"pbrMetallicRoughness", {{"baseColorFactor", {0.8, 0.8, 0.8, 1.0}}}}});
+    gltf["nodes"][0]["translation"] = {0.0, -0.5, 0.2};
+    gltf["nodes"][0]["rotation"] = {-std::sqrt(0.5), 0.0, 0.0, std::sqrt(0.5)};
+    gltf["extensionsUsed"] = {"KHR_lights_punctual"};
+    gltf["extensions"] = {{"KHR_lights_punctual", {{"lights", {{{"type", "point"}, {"intensity", 2.0}}}}}}};
+    gltf["nodes"].push_back({{"translation", {0.0, 0.0, 0.2}}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
+    gltf["scenes"][0]["nodes"] = {0, 1};
+    const fs::path dir = fs::path(TEST_OUTPUT_DIR) / "gltf";
+    fs::create_directories(dir);
+    std::ofstream(dir / "alone.gltf") << gltf.dump();
+    const fs::path scene = dir / "alone.json";
+    std::ofstream(scene) << R"({"box": {"walls": false}, "tumblers": [], "models": [{"file": "alone.gltf"}]})";
+    Rig rig(scene.string());
+    // No wall behind: the G-buffer's background there.
+    CHECK(rig.at("gbuffer", "normal", {0.6f, 0.6f, -1.0f}).w < 0.5f);
+    // The plate under the light: albedo / π × I / d² (d = 0.5, n · l = 1), plus what bounces
+    // off nothing but itself (the voxels hold only the plate): within 5 %.
+    const glm::vec3 centre(0.0f, -0.5f, 0.2f);
+    const float expected = 0.8f / 3.14159265f * 2.0f / 0.25f;
+    const float radiance = rig.at("composite", "hdr", centre).r;
+    INFO("radiance " << radiance << ", closed form " << expected);
+    CHECK(std::abs(radiance - expected) < 0.05f * expected);
+}
+
+TEST_CASE("kiln --scene model.gltf with lights of its own shows it without the box", "[gltf][gl]") {
+    nlohmann::json gltf = squareGltf(0.3f, 0.0f, "", {{"pbrMetallicRoughness", {{"baseColorFactor", {0.8, 0.8, 0.8, 1.0}}}}});
+    gltf["extensionsUsed"] = {"KHR_lights_punctual"};
+    gltf["extensions"] = {{"KHR_lights_punctual", {{"lights", {{{"type", "point"}, {"intensity", 2.0}}}}}}};
+    gltf["nodes"].push_back({{"translation", {0.0, 0.0, 1.0}}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
+    gltf["scenes"][0]["nodes"] = {0, 1};
+    const fs::path dir = fs::path(TEST_OUTPUT_DIR) / "gltf";
+    fs::create_directories(dir);
+    std::ofstream(dir / "lit_alone.gltf") << gltf.dump();
+    Rig rig((dir / "lit_alone.gltf").string());
+    CHECK_FALSE(rig.app.scene().look().walls);
+    CHECK(rig.app.runtime().findTexture("gbuffer", "normal"));
+    // The corners of the picture show no wall.
+    const FloatImage normal = test::readOutput(rig.app, "gbuffer", "normal");
+    CHECK(normal.at(2, 2)[3] < 0.5f);
+    CHECK(normal.at(kSize - 3, kSize - 3)[3] < 0.5f);
+}

@@ -259,3 +259,25 @@ TEST_CASE("a scene at the count limits, every ball in one grid cell, steps in bo
     const double packedBalls = double(kMaxMarbles + 1);  // and the one big fireball
     CHECK(packedStep.mostSubsteps * packedBalls * (packedBalls - 1.0) / 2.0 <= double(1 << 22));
 }
+
+TEST_CASE("models are read and checked, and a scene without walls holds no bodies", "[sim][scene]") {
+    Scene s;
+    SceneError e;
+    REQUIRE(parseScene(R"({"tumblers": [], "models": [{"file": "a.glb", "position": [0, -1, 0], "scale": 0.5,
+                            "rotation_deg": [0, 90, 0], "fit": true}]})", s, e));
+    REQUIRE(s.models.size() == 1);
+    CHECK(s.models[0].file == "a.glb");
+    CHECK(s.models[0].scale == 0.5);
+    CHECK(s.models[0].rotationDeg.y == 90.0);
+    CHECK(s.models[0].fit);
+    CHECK(errorOf(R"({"tumblers": [], "models": [{"position": [0, 0, 0]}]})").find("models[0].file: expected") !=
+          std::string::npos);
+    CHECK(errorOf(R"({"tumblers": [], "models": [{"file": "a.glb", "scale": 0}]})").find("models[0].scale") !=
+          std::string::npos);
+    CHECK(errorOf(R"({"tumblers": [], "models": [{"file": "a.glb", "colour": 1}]})")
+              .find("models[0].colour: unknown key") != std::string::npos);
+    REQUIRE(parseScene(R"({"box": {"walls": false}, "tumblers": []})", s, e));
+    CHECK_FALSE(s.box.walls);
+    CHECK(errorOf(R"({"box": {"walls": false}, "tumblers": [{"position": [0, 0]}]})")
+              .find("box.walls: false, but the scene has 1 tumblers") != std::string::npos);
+}
