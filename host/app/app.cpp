@@ -59,10 +59,19 @@ bool App::init(const Options& o, std::string& error) {
     if (!runtime_.init(ro, error)) return false;
     runtime_.readEverything = o.headless && !o.dump.empty();  // --dump writes every texture
     if (!scene_.load(o.scene, seedOverride(), error)) return false;
-    // A glTF file given as the scene is seen through its first camera, if it has one.
+    // A glTF file given as the scene is seen through its first camera, if it has one; a
+    // scene without the box from the box's side and 20° above, framing the scene's bounds.
     glm::vec3 eye, forward;
     float fovY = 0.0f;
-    if (scene_.modelCamera(eye, forward, fovY)) camera_.lookFrom(eye, forward, fovY);
+    if (scene_.modelCamera(eye, forward, fovY)) {
+        camera_.lookFrom(eye, forward, fovY);
+    } else if (!scene_.look().walls) {
+        const glm::vec3 lo = scene_.boundsMin(), hi = scene_.boundsMax();
+        camera_.target = 0.5f * (lo + hi);
+        camera_.pitch = 0.35f;
+        const float radius = std::max(0.5f * glm::length(hi - lo), 1e-3f);
+        camera_.distance = radius / std::sin(0.5f * camera_.fovY) * 1.05f;
+    }
     requested_ = requestedTextures();
     runtime_.setRequested(requested_);
     std::string errors;

@@ -81,12 +81,15 @@ glm::mat4 placementOf(const sim::Scene::ModelSpec& spec, const model::Model& m, 
         fit = glm::translate(glm::mat4(1.0f), glm::vec3(0.0f, -1.0f, 0.0f)) * glm::scale(glm::mat4(1.0f), glm::vec3(s)) *
               glm::translate(glm::mat4(1.0f), -base);
     }
+    // A fitted model turns and scales about where the fit put it (the middle of its base
+    // on the floor, or the volume's centre), so it stays standing there.
+    const glm::vec3 pivot = spec.fit && walls ? glm::vec3(0.0f, -1.0f, 0.0f) : glm::vec3(0.0f);
     const glm::vec3 r = glm::radians(glm::vec3(spec.rotationDeg));
-    glm::mat4 t = glm::translate(glm::mat4(1.0f), glm::vec3(spec.position));
+    glm::mat4 t = glm::translate(glm::mat4(1.0f), glm::vec3(spec.position) + pivot);
     t = glm::rotate(t, r.z, glm::vec3(0, 0, 1));
     t = glm::rotate(t, r.y, glm::vec3(0, 1, 0));
     t = glm::rotate(t, r.x, glm::vec3(1, 0, 0));
-    return t * glm::scale(glm::mat4(1.0f), glm::vec3(float(spec.scale))) * fit;
+    return t * glm::scale(glm::mat4(1.0f), glm::vec3(float(spec.scale))) * glm::translate(glm::mat4(1.0f), -pivot) * fit;
 }
 
 }  // namespace

@@ -151,8 +151,9 @@ struct Scene {
         glm::dvec3 position{0.0};
         double scale = 1.0;
         glm::dvec3 rotationDeg{0.0};  // about x, then y, then z
-        bool fit = false;             // scaled and moved to stand inside the box (position,
-                                      //   scale and rotation then apply after the fit)
+        bool fit = false;             // scaled and moved to stand inside the box (then
+                                      //   scaled and turned about its base's middle, and
+                                      //   moved by position)
     };
     std::vector<ModelSpec> models;
 };
