@@ -5,11 +5,17 @@
 // the centre pixel changes). Medians and maxima over --trials. A command, not a test:
 // prints a table and writes bench-out/scene.csv.
 //   kiln-bench-scene [--size WxH] [--trials N] [--out DIR] FILE.gltf|FILE.glb...
+//   kiln-bench-scene [--size WxH] --grow triangles=N1,N2,...|lights=N1,N2,...
+// --grow: a generated model (an 8 × 8 grid of spheres on the box's floor, N triangles in
+// all; or 100 000 of them under N point lights, which cast no shadows) in the box, and the
+// default pipeline's frame, every pass every frame, the median of --trials frames after
+// three, against the first N's.
 #include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -66,9 +72,147 @@ std::string recoloured(const std::string& bytes, float rgb) {
     return out + text + rest;
 }
 
+// A .glb of an 8 × 8 grid of UV spheres on the floor, about `triangles` in all, and
+// `lights` point lights in a ring above them.
+std::string gridGlb(uint64_t triangles, int lights) {
+    const int seg = std::max(3, int(std::lround(std::sqrt(double(triangles) / 64.0 / 4.0))));  // 4·seg² a sphere
+    std::vector<float> pos, nrm;
+    std::vector<uint32_t> idx;
+    for (int gz = 0; gz < 8; ++gz)
+        for (int gx = 0; gx < 8; ++gx) {
+            const glm::vec3 c(-0.7f + 0.2f * float(gx), -0.92f, -0.7f + 0.2f * float(gz));
+            const uint32_t base = uint32_t(pos.size() / 3);
+            for (int i = 0; i <= seg; ++i)
+                for (int j = 0; j <= 2 * seg; ++j) {
+                    const float th = 3.14159265f * float(i) / float(seg), ph = 3.14159265f * float(j) / float(seg);
+                    const glm::vec3 n(std::sin(th) * std::cos(ph), std::cos(th), std::sin(th) * std::sin(ph));
+                    const glm::vec3 p = c + 0.08f * n;
+                    pos.insert(pos.end(), {p.x, p.y, p.z});
+                    nrm.insert(nrm.end(), {n.x, n.y, n.z});
+                }
+            for (int i = 0; i < seg; ++i)
+                for (int j = 0; j < 2 * seg; ++j) {
+                    const uint32_t a = base + uint32_t(i * (2 * seg + 1) + j), b = a + uint32_t(2 * seg + 1);
+                    idx.insert(idx.end(), {a, a + 1, b, a + 1, b + 1, b});
+                }
+        }
+    std::string bin;
+    auto append = [&](const void* p, size_t n) { bin.append(static_cast<const char*>(p), n); };
+    append(pos.data(), pos.size() * 4);
+    append(nrm.data(), nrm.size() * 4);
+    append(idx.data(), idx.size() * 4);
+    const size_t vcount = pos.size() / 3;
+    nlohmann::json j = {
+        {"asset", {{"version", "2.0"}}}, {"scene", 0}, {"scenes", {{{"nodes", {0}}}}}, {"nodes", {{{"mesh", 0}}}},
+        {"meshes", {{{"primitives", {{{"attributes", {{"POSITION", 0}, {"NORMAL", 1}}}, {"indices", 2}}}}}}},
+        {"accessors", {{{"bufferView", 0}, {"componentType", 5126}, {"count", vcount}, {"type", "VEC3"}},
+                       {{"bufferView", 1}, {"componentType", 5126}, {"count", vcount}, {"type", "VEC3"}},
+                       {{"bufferView", 2}, {"componentType", 5125}, {"count", idx.size()}, {"type", "SCALAR"}}}},
+        {"bufferViews", {{{"buffer", 0}, {"byteOffset", 0}, {"byteLength", vcount * 12}},
+                         {{"buffer", 0}, {"byteOffset", vcount * 12}, {"byteLength", vcount * 12}},
+                         {{"buffer", 0}, {"byteOffset", vcount * 24}, {"byteLength", idx.size() * 4}}}},
+        {"buffers", {{{"byteLength", bin.size()}}}}};
+    if (lights > 0) {
+        j["extensionsUsed"] = {"KHR_lights_punctual"};
+        nlohmann::json list = nlohmann::json::array();
+        for (int l = 0; l < lights; ++l) {
+            list.push_back({{"type", "point"}, {"intensity", 1.0 / lights}});
+            const float a = 6.2831853f * float(l) / float(lights);
+            j["nodes"].push_back({{"translation", {0.5 * std::cos(a), 0.2, 0.5 * std::sin(a)}},
+                                  {"extensions", {{"KHR_lights_punctual", {{"light", l}}}}}});
+            j["scenes"][0]["nodes"].push_back(l + 1);
+        }
+        j["extensions"] = {{"KHR_lights_punctual", {{"lights", list}}}};
+    }
+    std::string text = j.dump();
+    while (text.size() % 4) text += ' ';
+    std::string out(20, '\0');
+    const uint32_t version = 2, total = uint32_t(20 + text.size() + 8 + bin.size()), length = uint32_t(text.size()),
+                   jsonType = 0x4E4F534Au, binLength = uint32_t(bin.size()), binType = 0x004E4942u;
+    std::memcpy(out.data(), "glTF", 4);
+    std::memcpy(out.data() + 4, &version, 4);
+    std::memcpy(out.data() + 8, &total, 4);
+    std::memcpy(out.data() + 12, &length, 4);
+    std::memcpy(out.data() + 16, &jsonType, 4);
+    std::string chunk(8, '\0');
+    std::memcpy(chunk.data(), &binLength, 4);
+    std::memcpy(chunk.data() + 4, &binType, 4);
+    return out + text + chunk + bin;
+}
+
+// The default pipeline's frame with the scene file `scene`, every pass every frame: the
+// median of `frames` after three.
+double frameMs(const std::string& scene, int width, int height, int frames, std::string& error) {
+    app::App a;
+    app::Options o;
+    app::applyDefaults(o);
+    o.headless = true, o.paused = true, o.live = false, o.width = width, o.height = height;
+    o.scene = scene;
+    if (!a.init(o, error)) return -1.0;
+    a.runtime().alwaysRun = true;
+    std::vector<double> ms;
+    for (int f = 0; f < frames + 3; ++f) {
+        const auto t0 = Clock::now();
+        a.frame();
+        glFinish();
+        if (f >= 3) ms.push_back(msSince(t0));
+    }
+    return medianMax(ms).first;
+}
+
+int grow(const std::string& spec, int width, int height, int frames, const std::string& outDir) {
+    const size_t eq = spec.find('=');
+    const std::string kind = spec.substr(0, eq);
+    if (eq == std::string::npos || (kind != "triangles" && kind != "lights")) {
+        std::fprintf(stderr, "kiln-bench-scene: --grow %s: expected triangles=N1,N2,... or lights=N1,N2,...\n", spec.c_str());
+        return 2;
+    }
+    std::vector<uint64_t> counts;
+    for (size_t at = eq + 1; at < spec.size();) {
+        size_t end = spec.find(',', at);
+        if (end == std::string::npos) end = spec.size();
+        char* stop = nullptr;
+        const std::string v = spec.substr(at, end - at);
+        const unsigned long long n = std::strtoull(v.c_str(), &stop, 10);
+        if (v.empty() || *stop || (kind == "lights" && n > uint64_t(kMaxPunctualLights)) || (kind == "triangles" && (n < 100 || n > 4'000'000))) {
+            std::fprintf(stderr, "kiln-bench-scene: --grow %s: %s is no count (triangles 100..4000000, lights 0..%d)\n",
+                         spec.c_str(), v.c_str(), kMaxPunctualLights);
+            return 2;
+        }
+        counts.push_back(n);
+        at = end + 1;
+    }
+    std::string error;
+    const fs::path dir = fs::temp_directory_path() / ("kiln-bench-scene-grow-" + std::to_string(getpid()));
+    fs::create_directories(dir);
+    fs::create_directories(outDir);
+    std::ofstream csv(fs::path(outDir) / ("grow_" + kind + ".csv"));
+    csv << kind << ",triangles,frame_ms,ratio\n";
+    std::printf("the default pipeline's frame, %dx%d, every pass every frame, median of %d frames\n", width, height, frames);
+    std::printf("  %10s %10s %10s %8s\n", kind.c_str(), "triangles", "frame ms", "ratio");
+    double first = 0.0;
+    for (uint64_t n : counts) {
+        const uint64_t triangles = kind == "triangles" ? n : 100'000;
+        const int lights = kind == "lights" ? int(n) : 0;
+        std::ofstream(dir / "grid.glb", std::ios::binary) << gridGlb(triangles, lights);
+        model::Model m;
+        if (!model::loadGltf((dir / "grid.glb").string(), m, error)) return std::fprintf(stderr, "kiln-bench-scene: error: %s\n", error.c_str()), 1;
+        std::ofstream(dir / "scene.json") << R"({"tumblers": [], "models": [{"file": "grid.glb"}]})";
+        const double ms = frameMs((dir / "scene.json").string(), width, height, frames, error);
+        if (ms < 0.0) return std::fprintf(stderr, "kiln-bench-scene: error: %s\n", error.c_str()), 1;
+        if (first == 0.0) first = ms;
+        std::printf("  %10llu %10llu %10.1f %8.2f\n", (unsigned long long)n, (unsigned long long)m.triangles(), ms, ms / first);
+        csv << n << "," << m.triangles() << "," << ms << "," << ms / first << "\n";
+    }
+    fs::remove_all(dir);
+    std::printf("wrote %s\n", (fs::path(outDir) / ("grow_" + kind + ".csv")).string().c_str());
+    return 0;
+}
+
 [[noreturn]] void usage(int code) {
     std::fprintf(code ? stderr : stdout,
                  "usage: kiln-bench-scene [--size WxH] [--trials N] [--out DIR] FILE.gltf|FILE.glb...\n"
+                 "       kiln-bench-scene [--size WxH] [--trials N] --grow triangles=N1,N2,...|lights=N1,N2,...\n"
                  "  load: parse, check and flatten the file; first frame: scene load, upload and the\n"
                  "  default pipeline's first frame; save->pixels: a material's colour saved until the\n"
                  "  centre pixel changes. A few seconds a file at 256x256 with 10 trials.\n");
@@ -81,6 +225,7 @@ int main(int argc, char** argv) {
     int width = 256, height = 256, trials = 10;
     std::string outDir = "bench-out";
     std::vector<std::string> files;
+    std::string growSpec;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
         auto next = [&]() -> std::string {
@@ -92,10 +237,11 @@ int main(int argc, char** argv) {
             if (std::sscanf(next().c_str(), "%dx%d", &width, &height) != 2 || width < 16 || height < 16) usage(2);
         } else if (a == "--trials") trials = std::max(2, std::atoi(next().c_str()));
         else if (a == "--out") outDir = next();
+        else if (a == "--grow") growSpec = next();
         else if (a.rfind("--", 0) == 0) usage(2);
         else files.push_back(a);
     }
-    if (files.empty()) usage(2);
+    if (files.empty() == growSpec.empty()) usage(2);
     std::string error;
     auto context = app::HeadlessContext::create(false, error);
     if (!context) {
@@ -103,6 +249,7 @@ int main(int argc, char** argv) {
         return 1;
     }
     log::setMinLevel(log::Level::Error);
+    if (!growSpec.empty()) return grow(growSpec, width, height, trials, outDir);
     fs::create_directories(outDir);
     std::ofstream csv(fs::path(outDir) / "scene.csv");
     csv << "file,measure,trial,ms\n";
