@@ -64,9 +64,16 @@ private:
     bool drawStatic(kiln::PassContext& ctx, GLuint program) {
         const kiln::SceneView& scene = ctx.scene();
         const int side = ctx.getInt("shadow_size");
+        const bool meshes = scene.count(kiln::kSceneMeshes) > 0;
+        const GLuint cutout =
+            meshes ? ctx.program({.stages = {"shadow/cutout.vert", "shadow/cutout.frag"},
+                                  .defines = {{"KILN_PUNCTUAL_LIGHT", "1"},
+                                              {"KILN_HAS_COLOR_LAYERS", scene.materialTextures[0] ? "1" : "0"}}})
+                   : 0;
+        if (meshes && !cutout) return false;
         const StaticKey key{{scene.version(kiln::kSceneBox), scene.version(kiln::kSceneLamp),
                              scene.version(kiln::kSceneMeshes), scene.version(kiln::kSceneLight)},
-                            program, side, ctx.getFloat("slope_bias")};
+                            program, cutout, side, ctx.getFloat("slope_bias"), scene.materialTextures[0]};
         if (key == built_ && staticAtlas_) return true;
         if (!staticAtlas_ || staticAtlas_.height() != side) {
             staticAtlas_ = kiln::gl::Texture::create(GL_TEXTURE_2D, GL_DEPTH_COMPONENT32F, side * kiln::kMaxShadowedLights,
@@ -83,17 +90,22 @@ private:
         const float one = 1.0f;
         glClearBufferfv(GL_DEPTH, 0, &one);
         // Everything opaque that stays casts: the walls and the dome too (a sun outside
-        // the box is shut out by it).
-        drawTiles(ctx, program, kiln::kSceneStatic | kiln::kSceneMeshes);
+        // the box is shut out by it), and the placed meshes with their cut-outs cut.
+        drawTiles(ctx, program, kiln::kSceneStatic);
+        if (meshes) {
+            kiln::gl::bindTexture(cutout, "u_colorLayers", scene.materialTextures[0]);
+            drawTiles(ctx, cutout, kiln::kSceneMeshes);
+        }
         built_ = key;
         return true;
     }
 
     struct StaticKey {
         std::array<uint64_t, 4> versions{};  // box, lamp, meshes, light
-        GLuint program = 0;
+        GLuint program = 0, cutout = 0;
         int side = 0;
         float slopeBias = -1.0f;
+        uint32_t textures = 0;
         bool operator==(const StaticKey&) const = default;
     };
     // A cache (a module reload starts over): what staticAtlas_ was drawn from.

@@ -46,7 +46,7 @@ public:
         if (!program) return;
         const kiln::SceneView& scene = ctx.scene();
         const bool meshes = scene.count(kiln::kSceneMeshes) > 0;
-        if (meshes && !drawStaticMeshes(ctx, program)) return;
+        if (meshes && !drawStaticMeshes(ctx)) return;
         if (!ctx.framebuffer({}, "depth")) return;
         const kiln::TextureRef& depth = ctx.output("depth");
         if (meshes) {
@@ -74,13 +74,16 @@ private:
         glUseProgram(program);
     }
 
-    // The placed meshes' depth from the lamp in staticDepth_, when what it depends on
-    // changed. False when the pass failed.
-    bool drawStaticMeshes(kiln::PassContext& ctx, GLuint program) {
+    // The placed meshes' depth from the lamp in staticDepth_, their cut-outs cut, when
+    // what it depends on changed. False when the pass failed.
+    bool drawStaticMeshes(kiln::PassContext& ctx) {
         const kiln::SceneView& scene = ctx.scene();
+        const GLuint program = ctx.program({.stages = {"shadow/cutout.vert", "shadow/cutout.frag"},
+                                            .defines = {{"KILN_HAS_COLOR_LAYERS", scene.materialTextures[0] ? "1" : "0"}}});
+        if (!program) return false;
         const int side = ctx.getInt("size");
         const StaticKey key{scene.version(kiln::kSceneMeshes), scene.version(kiln::kSceneLight), program, side,
-                            ctx.getFloat("slope_bias")};
+                            ctx.getFloat("slope_bias"), scene.materialTextures[0]};
         if (key == built_ && staticDepth_) return true;
         if (!staticDepth_ || staticDepth_.width() != side) {
             staticDepth_ = kiln::gl::Texture::create(GL_TEXTURE_2D, GL_DEPTH_COMPONENT32F, side, side, 1, 1,
@@ -98,6 +101,7 @@ private:
         const float one = 1.0f;
         glClearBufferfv(GL_DEPTH, 0, &one);
         beginCasters(ctx, program);
+        kiln::gl::bindTexture(program, "u_colorLayers", scene.materialTextures[0]);
         ctx.drawScene({.categories = kiln::kSceneMeshes});
         built_ = key;
         return true;
@@ -108,6 +112,7 @@ private:
         GLuint program = 0;
         int side = 0;
         float slopeBias = -1.0f;
+        uint32_t textures = 0;
         bool operator==(const StaticKey&) const = default;
     };
     // A cache (a module reload starts over): what staticDepth_ was drawn from.

@@ -209,6 +209,31 @@ TEST_CASE("a glTF model casts the lamp's shadow", "[gltf][gl]") {
     CHECK(under.r < 0.02f * beside.r);
 }
 
+TEST_CASE("an alpha-masked glTF material's cut-out lets the lamp through", "[gltf][gl]") {
+    // The plate of the shadow test with its top-right quadrant (as the image is seen)
+    // below the cutoff: turned face up, that quadrant lies over x in [0, 0.3], z in
+    // [-0.1, 0.2]. From the lamp's centre (0, 1.1, 0) its middle (0.15, -0.5, 0.05) falls
+    // on the floor at (0.197, -1, 0.066); the opposite, solid quadrant's at (-0.197, -1, 0.459).
+    const fs::path dir = fs::path(TEST_OUTPUT_DIR) / "gltf";
+    fs::create_directories(dir);
+    writeQuadrants(dir / "plate_cutout.png", {glm::vec4(1, 1, 1, 1), glm::vec4(1, 1, 1, 0.2f), glm::vec4(1, 1, 1, 1),
+                                              glm::vec4(1, 1, 1, 1)});
+    nlohmann::json gltf = squareGltf(0.3f, 0.0f, "plate_cutout.png",
+                                     {{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}},
+                                      {"alphaMode", "MASK"}, {"alphaCutoff", 0.5}});
+    gltf["nodes"][0]["translation"] = {0.0, -0.5, 0.2};
+    gltf["nodes"][0]["rotation"] = {-std::sqrt(0.5), 0.0, 0.0, std::sqrt(0.5)};
+    Rig rig(sceneWith("plate_cutout", gltf));
+    const float throughHole = rig.at("composite", "direct", {0.197f, -1.0f, 0.066f}).r;
+    const float underSolid = rig.at("composite", "direct", {-0.197f, -1.0f, 0.459f}).r;
+    const float beside = rig.at("composite", "direct", {0.7f, -1.0f, 0.6f}).r;
+    INFO("through the hole " << throughHole << ", under the solid part " << underSolid << ", beside " << beside);
+    // The hole (0.3 m wide, 0.5 m up) shows the whole lamp from there (it spans 0.17 m
+    // at the plate's height): lit as the open floor is, within the floor's own spread.
+    CHECK(throughHole > 0.5f * beside);
+    CHECK(underSolid < 0.02f * beside);
+}
+
 TEST_CASE("a glTF model keeps its shadow while the bodies move the shadow map", "[gltf][gl]") {
     // The plate as above, and a marble flying about the box: the shadow pass runs again
     // each frame the marble moves, drawing it over the plate's depth it keeps (drawn
