@@ -312,6 +312,30 @@ void panelScene(WindowState& state) {
                            app.droppedSeconds, app.stepBudgetMs);
     else if (!app.paused)
         ImGui::TextDisabled("real time: stepping %.2f ms this frame", app.lastStepMs);
+    // The camera, and the placed models with what of them is not drawn.
+    Camera& camera = app.camera();
+    bool fly = camera.mode == Camera::Mode::Fly;
+    if (ImGui::Checkbox("fly camera (C)", &fly)) fly ? camera.toFly() : camera.toOrbit();
+    state.probe.item("camera-fly");
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("W/S A/D Q/E move it (Shift: 4x), dragging turns it, the wheel moves it forward");
+    for (const scene::PlacedModel& placed : app.scene().models()) {
+        const model::Model& m = *placed.model;
+        const std::string name = m.files.empty() ? std::string("model") : std::filesystem::path(m.files[0]).filename().string();
+        const bool open = ImGui::TreeNode(name.c_str(), "%s%s", name.c_str(), m.warnings.empty() ? "" : " (warnings)");
+        state.probe.item("model:" + name);
+        if (!open) continue;
+        ImGui::Text("%llu triangles drawn, %zu meshes", static_cast<unsigned long long>(m.triangles()), m.meshes.size());
+        ImGui::Text("%zu materials, %zu images, %zu lights, %zu cameras", m.materials.size(), m.images.size(),
+                    m.lights.size(), m.cameras.size());
+        for (const std::string& file : m.files) {
+            ImGui::TextDisabled("%s", std::filesystem::path(file).filename().c_str());
+            if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", file.c_str());
+        }
+        ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.75f, 0.3f, 1.0f));
+        for (const std::string& w : m.warnings) ImGui::TextWrapped("%s", w.c_str());
+        ImGui::PopStyleColor();
+        ImGui::TreePop();
+    }
     ImGui::Separator();
     ImGui::Checkbox("resolution follows the budget", &state.autoScale);
     if (ImGui::IsItemHovered()) ImGui::SetTooltip("lowers the render resolution while frames take longer than the budget");
