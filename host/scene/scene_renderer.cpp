@@ -92,20 +92,21 @@ void SceneRenderer::buildMeshes() {
     auto addMesh = [&](const model::Mesh& m, const glm::mat4* bake) {
         meshes_.push_back({static_cast<uint32_t>(indices.size()), static_cast<uint32_t>(m.indices.size()),
                            static_cast<uint32_t>(vertices.size())});
-        const glm::mat3 normalMatrix = bake ? glm::transpose(glm::inverse(glm::mat3(*bake))) : glm::mat3(1.0f);
+        const glm::mat3 linear = bake ? glm::mat3(*bake) : glm::mat3(1.0f);
+        const glm::mat3 normalMatrix = glm::transpose(glm::inverse(linear));
+        const bool mirrored = glm::determinant(linear) < 0.0f;
         for (const model::Vertex& v : m.vertices) {
             if (bake) {
                 const glm::vec3 p = glm::vec3(*bake * glm::vec4(v.position, 1.0f));
-                const glm::vec3 t = glm::mat3(*bake) * glm::vec3(v.tangent);
+                const glm::vec3 t = linear * glm::vec3(v.tangent);
                 vertices.push_back({p, glm::normalize(normalMatrix * v.normal)});
                 surface.push_back({v.uv, glm::vec4(glm::length(t) > 0.0f ? glm::normalize(t) : glm::vec3(1, 0, 0),
-                                                   v.tangent.w * (glm::determinant(glm::mat3(*bake)) < 0 ? -1.0f : 1.0f))});
+                                                   mirrored ? -v.tangent.w : v.tangent.w)});
             } else {
                 vertices.push_back({v.position, v.normal});
                 surface.push_back({v.uv, v.tangent});
             }
         }
-        const bool mirrored = bake && glm::determinant(glm::mat3(*bake)) < 0.0f;
         for (size_t i = 0; i + 2 < m.indices.size(); i += 3) {
             indices.push_back(m.indices[i]);
             indices.push_back(m.indices[i + (mirrored ? 2 : 1)]);
@@ -195,7 +196,7 @@ GpuInstance SceneRenderer::materialInstance(const model::Model& mdl, uint32_t ma
 
 void SceneRenderer::setLook(const SceneLook& look) {
     look_ = look;
-    buildMeshes();
+    meshesStale_ = true;  // the lamp dome and the tumblers follow the look
     staticInstances_.clear();
     auto wall = [&](glm::mat4 m, glm::vec3 albedo, float material) {
         staticInstances_.push_back({m, glm::vec4(albedo, material), glm::vec4(look.wallEmission, 0.0f)});
@@ -222,7 +223,6 @@ void SceneRenderer::setLook(const SceneLook& look) {
     for (int i = 0; i < kSceneGeometryCount; ++i) ++versions_[i], hashes_[i] = 0;
     noteContents(kSceneBox, staticInstances_.data(), walls);
     noteContents(kSceneLamp, staticInstances_.data() + walls, staticInstances_.size() - walls);
-    noteContents(kSceneMeshes, meshInstances_.data(), meshInstances_.size());
     dirty_ = true;
 }
 
@@ -324,10 +324,9 @@ bool SceneRenderer::buildMaterials(const std::vector<PlacedModel>& models, std::
 bool SceneRenderer::setModels(const std::vector<PlacedModel>& models, std::string& error) {
     if (!buildMaterials(models, error)) return false;
     models_ = models;
-    buildMeshes();
+    meshesStale_ = true;
     // The meshes may differ with the same instances (a model edited live).
     ++versions_[sceneCategoryIndex(kSceneMeshes)];
-    noteContents(kSceneMeshes, meshInstances_.data(), meshInstances_.size());
     movedUnbounded_ = true;
     dirty_ = true;
     return true;
@@ -478,6 +477,12 @@ void SceneRenderer::rebuildGroups() {
 
 void SceneRenderer::upload() {
     if (!dirty_) return;
+    // Once for a new look and new models together (a scene load brings both).
+    if (meshesStale_) {
+        buildMeshes();
+        noteContents(kSceneMeshes, meshInstances_.data(), meshInstances_.size());
+        meshesStale_ = false;
+    }
     chooseLevels();
     rebuildGroups();
     std::vector<GpuInstance> all;

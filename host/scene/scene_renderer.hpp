@@ -100,8 +100,8 @@ inline float tumblerBoundingRadius(float b, float t, float alpha) {
 
 class SceneRenderer final : public run::SceneDraw {
 public:
-    // (Re)builds every mesh (the lamp dome and the tumblers follow the look) and the
-    // walls' instances. Called on every scene (re)load.
+    // The walls' instances, and every mesh rebuilt at the next upload() (the lamp dome
+    // and the tumblers follow the look). Called on every scene (re)load.
     void setLook(const SceneLook&);
     void setBodies(const std::vector<BodyInstance>&);
     void setParticles(const std::vector<ParticleInstance>&);
@@ -192,6 +192,7 @@ private:
     std::array<std::array<uint32_t, 3>, 2> sphereLevels_{};  // marbles, fireballs: near, mid, far
     bool tumblersNear_ = true;  // the camera's tumblers at their near mesh
     bool dirty_ = true;
+    bool meshesStale_ = true;  // buildMeshes() is owed (upload() runs it)
     std::vector<GpuInstance> givenBodies_;  // the bodies as setBodies last got them
     std::vector<glm::vec4> movedBodies_;
     bool movedUnbounded_ = true;
