@@ -110,6 +110,13 @@ FramebufferHandle createFramebuffer() {
     glCreateFramebuffers(1, &id);
     return FramebufferHandle(id);
 }
+FramebufferHandle createDepthFramebuffer(GLuint depthTexture) {
+    FramebufferHandle fbo = createFramebuffer();
+    glNamedFramebufferTexture(fbo.id(), GL_DEPTH_ATTACHMENT, depthTexture, 0);
+    glNamedFramebufferDrawBuffer(fbo.id(), GL_NONE);
+    if (glCheckNamedFramebufferStatus(fbo.id(), GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) fbo.reset();
+    return fbo;
+}
 VertexArrayHandle createVertexArray() {
     GLuint id = 0;
     glCreateVertexArrays(1, &id);

@@ -75,13 +75,11 @@ private:
                              scene.version(kiln::kSceneMeshes), scene.version(kiln::kSceneLight)},
                             program, cutout, side, ctx.getFloat("slope_bias"), scene.materialTextures[0]};
         if (key == built_ && staticAtlas_) return true;
-        if (!staticAtlas_ || staticAtlas_.height() != side) {
+        if (!staticAtlas_ || !framebuffer_ || staticAtlas_.height() != side) {
             staticAtlas_ = kiln::gl::Texture::create(GL_TEXTURE_2D, GL_DEPTH_COMPONENT32F, side * kiln::kMaxShadowedLights,
                                                      side, 1, 1, "lights.static_atlas");
-            framebuffer_ = kiln::gl::createFramebuffer();
-            glNamedFramebufferTexture(framebuffer_.id(), GL_DEPTH_ATTACHMENT, staticAtlas_.id(), 0);
-            glNamedFramebufferDrawBuffer(framebuffer_.id(), GL_NONE);
-            if (glCheckNamedFramebufferStatus(framebuffer_.id(), GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+            framebuffer_ = kiln::gl::createDepthFramebuffer(staticAtlas_.id());
+            if (!framebuffer_) {
                 ctx.fail("the static casters' atlas is incomplete as a framebuffer");
                 return false;
             }

@@ -85,13 +85,11 @@ private:
         const StaticKey key{scene.version(kiln::kSceneMeshes), scene.version(kiln::kSceneLight), program, side,
                             ctx.getFloat("slope_bias"), scene.materialTextures[0]};
         if (key == built_ && staticDepth_) return true;
-        if (!staticDepth_ || staticDepth_.width() != side) {
+        if (!staticDepth_ || !framebuffer_ || staticDepth_.width() != side) {
             staticDepth_ = kiln::gl::Texture::create(GL_TEXTURE_2D, GL_DEPTH_COMPONENT32F, side, side, 1, 1,
                                                      "shadow.static_meshes");
-            framebuffer_ = kiln::gl::createFramebuffer();
-            glNamedFramebufferTexture(framebuffer_.id(), GL_DEPTH_ATTACHMENT, staticDepth_.id(), 0);
-            glNamedFramebufferDrawBuffer(framebuffer_.id(), GL_NONE);
-            if (glCheckNamedFramebufferStatus(framebuffer_.id(), GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+            framebuffer_ = kiln::gl::createDepthFramebuffer(staticDepth_.id());
+            if (!framebuffer_) {
                 ctx.fail("the static meshes' depth map is incomplete as a framebuffer");
                 return false;
             }

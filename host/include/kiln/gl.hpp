@@ -96,6 +96,10 @@ using SamplerHandle = Handle<detail::deleteSampler>;
 
 // New, empty objects with one owner each (glCreate*: DSA names, usable at once).
 FramebufferHandle createFramebuffer();
+// A framebuffer whose one attachment is level 0 of `depthTexture` (no colour: draw
+// buffer none), for a depth map a pass keeps of its own; empty when GL finds it
+// incomplete.
+FramebufferHandle createDepthFramebuffer(GLuint depthTexture);
 VertexArrayHandle createVertexArray();
 SamplerHandle createSampler();
 
