@@ -116,6 +116,13 @@ std::optional<uint64_t> App::seedOverride() const {
 }
 
 SceneView App::buildView() {
+    {
+        // The whole scene in view from where the camera is, with room to back off; the
+        // box's planes (kCameraFar) for anything smaller, so its depth is unchanged.
+        const glm::vec3 lo = scene_.boundsMin(), hi = scene_.boundsMax();
+        const float reach = glm::distance(camera_.position(), 0.5f * (lo + hi)) + 0.5f * glm::length(hi - lo);
+        camera_.farPlane = std::max(kCameraFar, 2.0f * reach);
+    }
     const glm::mat4 view = camera_.view();
     const glm::mat4 proj = camera_.projection(float(options_.width) / float(options_.height));
     scene_.writeTo(renderer_, scene_.sim().dragged());
@@ -140,11 +147,13 @@ SceneView App::buildView() {
     v.frame.boxWalls = glm::uvec4(look.walls ? boxWallBits(look.closed) : 0u, 0u, 0u, 0u);
     v.frame.sceneMin = glm::vec4(scene_.boundsMin(), 0.0f);
     v.frame.sceneMax = glm::vec4(scene_.boundsMax(), 0.0f);
+    v.frame.voxelVolume = voxelVolumeAround(scene_.boundsMin(), scene_.boundsMax());
     scene::packPunctualLights(scene_.lights(), scene_.boundsMin(), scene_.boundsMax(), v.frame);
     v.materialTextures[0] = renderer_.materialTexture(0);
     v.materialTextures[1] = renderer_.materialTexture(1);
 
     if (v.frame.viewProj != lastViewProj_) lastViewProj_ = v.frame.viewProj, ++cameraVersion_;
+    lastVoxelVolume_ = v.frame.voxelVolume;
     for (int i = 0; i < kSceneGeometryCount; ++i) {
         const auto c = SceneCategory(1u << i);
         v.versions[i] = renderer_.version(c);

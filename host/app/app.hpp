@@ -42,6 +42,8 @@ public:
     double droppedSeconds = 0;  // simulated time given up to the budget since the last reset or reload
     // The camera's view-projection of the last frame built (what its textures hold).
     const glm::mat4& viewProj() const { return lastViewProj_; }
+    // The voxel volume of the last frame built (GpuFrame::voxelVolume).
+    const glm::vec4& voxelVolume() const { return lastVoxelVolume_; }
     // The graph output, or the texture chosen with --view / in the debug view.
     const TextureRef* displayedTexture() const;
 
@@ -85,6 +87,7 @@ private:
     LiveReload live_;
     uint64_t frameIndex_ = 0;
     glm::mat4 lastViewProj_{0.0f};
+    glm::vec4 lastVoxelVolume_{0.0f, 0.0f, 0.0f, 1.0f};
     uint64_t cameraVersion_ = 0, timeVersion_ = 0;
     uint64_t lastVersions_[kSceneCategoryCount] = {};  // the last frame's, for chooseRedraw
     int redrawBand_ = 0;

@@ -25,7 +25,7 @@ glm::mat4 Camera::view() const {
     return glm::lookAt(eye, eye + forward(), glm::vec3(0, 1, 0));
 }
 
-glm::mat4 Camera::projection(float aspect) const { return glm::perspective(fovY, aspect, kCameraNear, kCameraFar); }
+glm::mat4 Camera::projection(float aspect) const { return glm::perspective(fovY, aspect, kCameraNear, farPlane); }
 
 void Camera::rayThrough(double x, double y, int width, int height, glm::vec3& origin, glm::vec3& direction) const {
     const glm::mat4 inv = glm::inverse(projection(float(width) / float(height)) * view());

@@ -2,7 +2,7 @@
 // texture of every pass at one pixel of the image, in the order the passes ran, with the
 // pass that wrote it. A 2D texture is read where the pixel falls in it (its centre's
 // uv × that texture's size: a half-size bloom at the matching texel); a 3D texture (the
-// voxels over the box [-1,1]³) at the world position the camera's depth gives the pixel,
+// voxels over the voxel volume) at the world position the camera's depth gives the pixel,
 // in every tile of a tiled atlas.
 #pragma once
 
@@ -33,8 +33,9 @@ struct PixelTrace {
     std::vector<TraceRow> rows;
 };
 
-// `invViewProj`: the camera's, for the frame the textures hold. The camera's depth is
+// `invViewProj`: the camera's, for the frame the textures hold; `voxelVolume` that
+// frame's (GpuFrame::voxelVolume), where a 3D texture is read. The camera's depth is
 // the 2D depth texture declared with the camera's planes (kCameraNear, kCameraFar).
-PixelTrace tracePixel(const run::Runtime&, const glm::mat4& invViewProj, glm::vec2 uv);
+PixelTrace tracePixel(const run::Runtime&, const glm::mat4& invViewProj, glm::vec4 voxelVolume, glm::vec2 uv);
 
 }  // namespace kiln::app

@@ -163,7 +163,8 @@ public:
             .internal({.name = "samples", .format = Format::RGBA16F, .size = traceGrid,
                        .doc = "trace_stride > 1: the traced samples"})
             .internal({.name = "planes", .format = Format::RGBA16F, .size = traceGrid,
-                       .doc = "trace_stride > 1: each sample's surface, xyz = normal, w = n·p (0,0,0 off geometry)"})
+                       .doc = "trace_stride > 1: each sample's surface, xyz = normal, w = n·(p − the voxel "
+                               "volume's centre) (0,0,0 off geometry)"})
             .internal({.name = "ages", .format = Format::RGBA32F, .size = traceGrid,
                        .doc = "reuse_frames > 1: x = frames each sample's light has been kept (0: traced this frame), "
                               "yzw = the world point it was traced at"})

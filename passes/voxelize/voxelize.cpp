@@ -1,4 +1,4 @@
-// voxelize — the scene's outgoing radiance in a res³ volume over the box [-1,1]³
+// voxelize — the scene's outgoing radiance in a res³ volume over the scene (GpuFrame::voxelVolume):
 // direct light from the lamp (hard shadow from `shadow_map`, no PCF; the
 // same lampLight() as composite) plus emission, from the Cornell box, the lamp dome,
 // the tumblers (low-poly LOD), the fireballs and the particles (marbles on request).
@@ -121,7 +121,7 @@ public:
                            "lamp or the box changes: each frame's sums start from them"});
         d.internal({.name = "lamp_field", .format = Format::RG16F, .size = SizeRule::fixed(kLampFieldSide, kLampFieldSide),
                     .doc = "lamp_model field: the lamp's vector irradiance over (distance from its axis, height)"});
-        d.param(intChoiceParam("resolution", 64, {32, 64, 128}, "voxels per side over [-1,1]^3"))
+        d.param(intChoiceParam("resolution", 64, {32, 64, 128}, "voxels per side of the voxel volume (the cube around the scene)"))
             .param(boolParam("conservative", true, "enlarge triangles by half a voxel (no holes from thin triangles)"))
             .param(boolParam("keep_static", true,
                              "rasterize the walls and the lamp dome once (again when they or the lamp change) "
@@ -442,7 +442,7 @@ private:
         const uint32_t tumblers = scene.count(kiln::kSceneTumblers);
         if (tumblers == 0) return;
         const glm::vec4& shape = scene.frame.tumblerShape;
-        const float reach = 0.5f * shape.w + shape.x, voxel = 2.0f / float(res);
+        const float reach = 0.5f * shape.w + shape.x, voxel = 2.0f * scene.frame.voxelVolume.w / float(res);
         const int side = std::min(res, int(std::ceil(2.0f * reach / voxel)) + 1);  // +1: the cube starts at a floor
         useSurfaceProgram(ctx, program, res);
         glUniform1ui(glGetUniformLocation(program, "u_first"), scene.firstInstance(kiln::kSceneTumblers));

@@ -44,7 +44,7 @@ float discOverlap(float a, float b, float c) {
 }
 
 float fireTransmittance(vec3 p, vec3 n) {
-    float voxel = 2.0 / float(textureSize(u_fire, 0).x);
+    float voxel = kilnVoxelSize(float(textureSize(u_fire, 0).x));
     vec3 origin = p + n * (0.5 * voxel);
     vec3 toLamp = lightEye() - origin;
     float dist = length(toLamp);
@@ -151,7 +151,7 @@ float fireTransmittance(vec3 p, vec3 n) {
         // A mip level's texel, trilinearly filtered, spreads a sphere over about twice
         // the width (per axis σ = texel/2) of a disc of the same diameter (σ = d/4): a
         // level finer. Rounded to a whole level: llvmpipe then reads one level, not two.
-        float mu = textureLod(u_fire, (origin + dir * t) * 0.5 + 0.5, round(log2(diameter / voxel) - 1.0)).r;  // μ·h
+        float mu = textureLod(u_fire, kilnVolumeTexcoord(origin + dir * t), round(log2(diameter / voxel) - 1.0)).r;  // μ·h
         depth += mu * min(spacing, end - t) / voxel;
         t += spacing;
     }

@@ -23,6 +23,16 @@ layout(std140, binding = 0) uniform KilnFrame {
     uvec4 u_boxWalls;    // x: faces of [-1,1]³ with a wall, bit 2a: −axis a, 2a+1: +axis a
     vec4 u_sceneMin;     // the scene's bounds, world space
     vec4 u_sceneMax;
+    vec4 u_voxelVolume;  // the voxel passes' cube: xyz centre, w half side (world)
     uvec4 u_punctualCount;  // x: u_punctual[0 .. x) are lights
     KilnPunctualLight u_punctual[kMaxPunctualLights];
 };
+
+// The voxel volume: world space ↔ volume space (the cube as [-1,1]³, where the voxel
+// passes rasterize, splat and trace) ↔ texture space ([0,1]³). For a scene of [-1,1]³
+// every map is the identity, exactly.
+vec3 kilnWorldToVolume(vec3 p) { return (p - u_voxelVolume.xyz) / u_voxelVolume.w; }
+vec3 kilnVolumeToWorld(vec3 q) { return q * u_voxelVolume.w + u_voxelVolume.xyz; }
+vec3 kilnVolumeTexcoord(vec3 p) { return kilnWorldToVolume(p) * 0.5 + 0.5; }
+// A voxel's side in world units on a grid of `res` per side.
+float kilnVoxelSize(float res) { return 2.0 * u_voxelVolume.w / res; }

@@ -109,13 +109,16 @@ void main() {
         // indirect light): traced here at one pixel in stride², upsampled with it.
         indirect.a = lampProjectedSolidAngle(p, n);
 #elif KILN_HAS_LAMP_TRANSMITTANCE
-        indirect.a = textureLod(u_lampTransmittance, p * 0.5 + 0.5, 0.0).r;  // upsampled for composite
+        indirect.a = textureLod(u_lampTransmittance, kilnVolumeTexcoord(p), 0.0).r;  // upsampled for composite
 #endif
 #if KILN_REUSE
         age4 = vec4(0.0, p);
 #endif
     }
-    store(ij, indirect, vec4(n, dot(n, p)));
+    // The plane's offset from the voxel volume's centre: half floats hold it to the
+    // scene's scale wherever the scene lies (from the world origin, 40 m away they
+    // held it to 3 cm).
+    store(ij, indirect, vec4(n, dot(n, p - u_voxelVolume.xyz)));
 #if KILN_REUSE
     imageStore(u_ages, ij, age4);
 #endif

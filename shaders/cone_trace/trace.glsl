@@ -8,8 +8,9 @@ uniform float u_diameterOffset;   // × each sample's diameter, along the normal
 // per step the distance t, the cone diameter, the mip level and spacing/diameter.
 const vec4 kSchedule[KILN_CONE_STEPS] = vec4[](KILN_CONE_SCHEDULE);
 
-// Front-to-back composite along one cone: rgb = radiance arriving (premultiplied),
-// a = opacity met. Samples outside the box count as empty (the walls sit in the
+// Front-to-back composite along one cone, in volume space (common/frame.glsl: the voxel
+// volume as [-1,1]³, where the step schedule is laid out): rgb = radiance arriving
+// (premultiplied), a = opacity met. Samples outside the box count as empty (the walls sit in the
 // outermost voxels, so nothing is lost).
 // tile: the cone's index in the fixed set (KILN_HAS_FIXED_CONES), else unused.
 vec4 traceCone(vec3 origin, vec3 n, vec3 dir, int tile) {
@@ -34,7 +35,7 @@ vec4 traceCone(vec3 origin, vec3 n, vec3 dir, int tile) {
     return acc;
 }
 
-// Indirect irradiance at p with normal n, as the cosine-weighted mean incoming
+// Indirect irradiance at world point p with normal n, as the cosine-weighted mean incoming
 // radiance (so outgoing diffuse = albedo × rgb); a = ambient visibility (1 − the
 // weighted cone opacity).
 #if KILN_HAS_FIXED_CONES
@@ -46,7 +47,7 @@ vec4 traceCone(vec3 origin, vec3 n, vec3 dir, int tile) {
 const float kMinCosine = 0.05;
 
 vec4 traceDiffuse(vec3 p, vec3 n) {
-    vec3 origin = p + n * (u_startOffset * 2.0 / u_voxelRes);
+    vec3 origin = kilnWorldToVolume(p) + n * (u_startOffset * 2.0 / u_voxelRes);
     uint pairs = 0u;
     for (int j = 0; j < kFixedConePairs; ++j)
         if (abs(dot(n, kFixedCone[j])) >= kMinCosine) pairs |= 1u << j;
@@ -72,7 +73,7 @@ vec4 traceDiffuse(vec3 p, vec3 n) {
     vec3 up = abs(n.y) < 0.95 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0);
     vec3 tx = normalize(cross(up, n));
     vec3 ty = cross(n, tx);
-    vec3 origin = p + n * (u_startOffset * 2.0 / u_voxelRes);
+    vec3 origin = kilnWorldToVolume(p) + n * (u_startOffset * 2.0 / u_voxelRes);
     vec4 sum = vec4(0.0);
     for (int i = 0; i < u_coneCount; ++i) {
         vec3 d = normalize(u_cones[i].x * tx + u_cones[i].y * ty + u_cones[i].z * n);

@@ -28,7 +28,7 @@ float surfaceMatch(vec3 n, vec3 p, ivec2 h) {
     float c = max(dot(n, plane.xyz), 0.0);  // 0 where the sample saw no geometry
     c *= c;
     c *= c;
-    return c * c * exp(-abs(dot(plane.xyz, p) - plane.w) / u_planeTolerance);
+    return c * c * exp(-abs(dot(plane.xyz, p - u_voxelVolume.xyz) - plane.w) / u_planeTolerance);
 }
 
 void main() {

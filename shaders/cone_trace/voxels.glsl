@@ -1,7 +1,7 @@
 // Sampling the mipped voxel radiance (passes/voxel_mip): quadrilinear lookups (trilinear
 // inside a level, linear between levels) of premultiplied colour + opacity over the
-// box [-1,1]³. Below level 1 every mode blends in the isotropic base (level 0 has no
-// directions). From level 1:
+// voxel volume ([-1,1]³ in volume space, common/frame.glsl). Below level 1 every mode
+// blends in the isotropic base (level 0 has no directions). From level 1:
 //   KILN_HAS_FIXED_CONES  the cone is direction `tile` of the fixed set: one fetch from
 //                         voxel_mip.fixed_cones (the directional chains pre-blended).
 //   KILN_HAS_ANISO        the direction d picks three of the six directional chains by

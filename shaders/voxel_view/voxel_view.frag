@@ -1,6 +1,6 @@
 #version 450 core
 // Ray-march the voxels at one mip level: a 3D DDA (Amanatides & Woo) over the level's
-// grid inside [-1,1]³, compositing premultiplied colour front to back until opaque.
+// grid over the voxel volume (in volume space, [-1,1]³), compositing premultiplied colour front to back until opaque.
 #include "common/frame.glsl"
 
 in vec2 v_uv;
@@ -13,8 +13,8 @@ uniform float u_minOpacity;
 void main() {
     vec4 nearP = u_invViewProj * vec4(v_uv * 2.0 - 1.0, -1.0, 1.0);
     vec4 farP = u_invViewProj * vec4(v_uv * 2.0 - 1.0, 1.0, 1.0);
-    vec3 ro = nearP.xyz / nearP.w;
-    vec3 rd = normalize(farP.xyz / farP.w - ro);
+    vec3 ro = kilnWorldToVolume(nearP.xyz / nearP.w);
+    vec3 rd = normalize(kilnWorldToVolume(farP.xyz / farP.w) - ro);
     vec3 inv = 1.0 / rd;
     vec3 t0 = (vec3(-1.0) - ro) * inv, t1 = (vec3(1.0) - ro) * inv;
     float tEnter = max(max(min(t0.x, t1.x), min(t0.y, t1.y)), max(min(t0.z, t1.z), 0.0));

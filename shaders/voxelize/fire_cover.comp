@@ -17,6 +17,7 @@
 
 layout(local_size_x = 64) in;
 
+#include "common/frame.glsl"
 #include "common/instances.glsl"
 
 uniform uint u_first;
@@ -28,8 +29,11 @@ void main() {
     KilnInstance inst = kiln_instances[u_first + gl_GlobalInvocationID.x];
     vec3 centre = kilnSphereCentre(inst);
     float radius = kilnSphereRadius(inst);
+    // In volume space (the voxel volume as [-1,1]³), then in voxel units: the cube
+    // [lo, hi] and the voxels it overlaps.
+    centre = kilnWorldToVolume(centre);
+    radius /= u_voxelVolume.w;
     float voxel = 2.0 / float(u_res);
-    // In voxel units: the cube [lo, hi] and the voxels it overlaps.
     vec3 lo = (centre - radius + 1.0) / voxel, hi = (centre + radius + 1.0) / voxel;
     ivec3 first = max(ivec3(floor(lo)), ivec3(0)), last = min(ivec3(floor(hi)), ivec3(u_res - 1));
     float side = max(hi.x - lo.x, 1e-6);

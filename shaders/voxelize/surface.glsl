@@ -28,7 +28,7 @@ vec3 lampIrradiance(vec3 p, vec3 n) {
 float lampVisibility(vec3 p, vec3 n) {
     float vis = 1.0;
 #if KILN_HAS_SHADOW_MAP
-    vis = u_unshadowed ? 1.0 : shadowHard(u_shadowMap, p + n * (2.0 / float(u_res)), u_shadowBias);
+    vis = u_unshadowed ? 1.0 : shadowHard(u_shadowMap, p + n * kilnVoxelSize(float(u_res)), u_shadowBias);
 #endif
     return vis;
 }
@@ -44,6 +44,6 @@ vec3 lampReflected(vec3 albedo, vec3 p, vec3 n) { return lampReflected(albedo, l
 // times the sphere's flux (0.34 of it is right for a 6 cm fireball at 32³). The factor
 // that gives the blob the sphere's flux.
 float sphereFluxScale(float r) {
-    float h = 2.0 / float(u_res);
+    float h = kilnVoxelSize(float(u_res));
     return min(1.0, 3.14159265 * r * r / ((2.0 * r + h) * (2.0 * r + h)));
 }

@@ -36,7 +36,8 @@ void main() {
     // derivative is undefined - llvmpipe only masks a discarded lane and still gave the
     // right span, NVIDIA's driver does not, and its tumblers' shells lost voxels where
     // their surfaces turn steep (the indirect light under them was 1.8x llvmpipe's).
-    float depth = v_axis == 0 ? v_world.x : v_axis == 1 ? v_world.y : v_world.z;
+    vec3 q = kilnWorldToVolume(v_world);
+    float depth = v_axis == 0 ? q.x : v_axis == 1 ? q.y : q.z;
     float span = 0.5 * (abs(dFdx(depth)) + abs(dFdy(depth)));
 
     vec2 px = gl_FragCoord.xy - vec2(float(v_axis * u_axisViewportStep), 0.0);

@@ -1,12 +1,14 @@
 #version 450 core
 // Voxelization, stage 2: project each triangle on the axis its normal is most aligned
-// with (an orthographic view of [-1,1]³ along x, y or z), and enlarge it by half a
+// with (an orthographic view of the voxel volume, [-1,1]³ in volume space, along x, y or z), and enlarge it by half a
 // pixel diagonal so every voxel it touches gets a fragment (conservative rasterisation
 // after Hasselgren et al., GPU Gems 2 ch. 42). The enlarged corners' world positions
 // are extrapolated on the triangle's plane (the projection is affine, so this is exact).
 // Each axis draws into a viewport of its own, apart from the others by whole tiles of
 // llvmpipe's 64 × 64 (voxelize.cpp sets them up): a framebuffer as small as the voxels
 // is one tile, and llvmpipe shades a tile on one thread.
+#include "common/frame.glsl"
+
 layout(triangles) in;
 layout(triangle_strip, max_vertices = 3) out;
 
@@ -24,7 +26,7 @@ flat out vec2 v_depthRange;  // min/max of the projection-axis coordinate over t
 uniform int u_res;
 uniform float u_conservative;
 
-// World → (2D on the projection plane, depth along the axis), all in [-1,1].
+// Volume space → (2D on the projection plane, depth along the axis), all in [-1,1].
 vec3 project(vec3 w, int axis) {
     return axis == 0 ? w.yzx : axis == 1 ? w.zxy : w.xyz;
 }
@@ -35,7 +37,7 @@ void main() {
     int axis = (fn.x >= fn.y && fn.x >= fn.z) ? 0 : (fn.y >= fn.z ? 1 : 2);
 
     vec3 q[3];
-    for (int i = 0; i < 3; ++i) q[i] = project(vg_world[i], axis);
+    for (int i = 0; i < 3; ++i) q[i] = project(kilnWorldToVolume(vg_world[i]), axis);
     vec2 p[3] = vec2[3](q[0].xy, q[1].xy, q[2].xy);
     float pixel = 2.0 / float(u_res);
     float hp = 0.5 * pixel * u_conservative;

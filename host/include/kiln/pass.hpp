@@ -227,9 +227,9 @@ namespace kiln {
 // FrameInfo::redraw; 12: TextureRef::setup; 13: Lod::Fine, and Lod::High's tumblers by
 // their size on screen; 14: PassContext::isRead and TextureDecl::onlyWhenRead; 15:
 // kSceneMeshes (the bits after it moved up), GpuInstance's material fields and
-// SceneView::materialTextures), so a module built for other terms is refused by name,
-// not run.
-inline constexpr uint32_t kPassAbiVersion = 15;
+// SceneView::materialTextures; 16: GpuFrame::voxelVolume), so a module built for
+// other terms is refused by name, not run.
+inline constexpr uint32_t kPassAbiVersion = 16;
 
 struct TextureRef {
     GLuint id = 0;

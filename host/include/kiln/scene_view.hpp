@@ -5,6 +5,7 @@
 // read-only for passes.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 
 #include <glm/glm.hpp>
@@ -88,15 +89,29 @@ struct GpuFrame {
                              //   −axis a, 2a+1 for +axis a (the open Cornell box: all but +z)
     glm::vec4 sceneMin;      // the scene's bounds (every instance's, world space); w unused
     glm::vec4 sceneMax;
+    glm::vec4 voxelVolume{0.0f, 0.0f, 0.0f, 1.0f};  // the cube the voxel passes cover (voxelVolumeAround): xyz its
+                             //   centre, w half its side, world space; shaders map through
+                             //   kilnWorldToVolume and kin (shaders/common/frame.glsl)
     glm::uvec4 punctualCount;  // x: lights[0 .. x) hold punctual lights
     GpuPunctualLight punctual[kMaxPunctualLights];
 };
+
+// The voxel volume of a scene with bounds [lo, hi]: the smallest cube around them,
+// centred on them (voxels are cubes, so the cone tracer's apertures hold on every axis).
+// A scene of [-1,1]³ gets exactly that cube.
+inline glm::vec4 voxelVolumeAround(glm::vec3 lo, glm::vec3 hi) {
+    const glm::vec3 half = 0.5f * (hi - lo);
+    const float side = std::max(std::max(half.x, half.y), std::max(half.z, 1e-3f));
+    return glm::vec4(0.5f * (lo + hi), side);
+}
 
 // GpuFrame::boxWalls.x of a box with or without its front wall (z = +1).
 constexpr uint32_t boxWallBits(bool closed) { return closed ? 0x3Fu : 0x1Fu; }
 
 // The host camera's clip planes (GpuFrame::proj): what a pass that rasterises from the
-// camera declares as its depth output's depthNear/depthFar.
+// camera declares as its depth output's depthNear/depthFar (the texture viewer
+// linearises depth with them). A scene that reaches past kCameraFar gets a farther
+// plane; GpuFrame::proj is then the one to read.
 inline constexpr float kCameraNear = 0.05f, kCameraFar = 20.0f;
 
 inline constexpr unsigned kFrameBinding = 0;      // uniform block
