@@ -140,14 +140,17 @@ SceneView App::buildView() {
     const scene::SceneLook& look = scene_.look();
     v.frame.lightPos = glm::vec4(look.lampCentre, look.lampRadius);
     v.frame.lightColor = glm::vec4(look.lampColor * look.lampIntensity, look.lampIntensity);
-    v.frame.woodLight = glm::vec4(look.woodLight, look.woodRingFrequency);
-    v.frame.woodDark = glm::vec4(look.woodDark, 0.0f);
-    v.frame.tumblerShape = glm::vec4(look.tumblerB, look.tumblerT, look.tumblerAlpha,
+    v.frame.ringsLight = glm::vec4(look.ringsLight, look.woodRingFrequency);
+    v.frame.ringsDark = glm::vec4(look.ringsDark, 0.0f);
+    v.frame.roundCone = glm::vec4(look.tumblerB, look.tumblerT, look.tumblerAlpha,
                                      (look.tumblerB - look.tumblerT) / std::sin(look.tumblerAlpha));
-    v.frame.boxWalls = glm::uvec4(look.walls ? boxWallBits(look.closed) : 0u, 0u, 0u, 0u);
+    v.frame.voxelVolume = voxelVolumeAround(scene_.boundsMin(), scene_.boundsMax());
+    // The box's walls close the volume's faces only where the volume is the box (a model
+    // reaching out of it widens the volume past the walls).
+    const bool volumeIsBox = v.frame.voxelVolume == glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
+    v.frame.closedFaces = glm::uvec4(look.walls && volumeIsBox ? closedFaceBits(look.closed) : 0u, 0u, 0u, 0u);
     v.frame.sceneMin = glm::vec4(scene_.boundsMin(), 0.0f);
     v.frame.sceneMax = glm::vec4(scene_.boundsMax(), 0.0f);
-    v.frame.voxelVolume = voxelVolumeAround(scene_.boundsMin(), scene_.boundsMax());
     scene::packPunctualLights(scene_.lights(), scene_.boundsMin(), scene_.boundsMax(), v.frame);
     v.materialTextures[0] = renderer_.materialTexture(0);
     v.materialTextures[1] = renderer_.materialTexture(1);
@@ -159,7 +162,7 @@ SceneView App::buildView() {
         v.versions[i] = renderer_.version(c);
         v.counts[i] = renderer_.count(c);
     }
-    v.versions[sceneCategoryIndex(kSceneLight)] = scene_.lightsVersion();
+    v.versions[sceneCategoryIndex(kSceneLights)] = scene_.lightsVersion();
     v.versions[sceneCategoryIndex(kSceneCamera)] = cameraVersion_;
     v.versions[sceneCategoryIndex(kSceneTime)] = timeVersion_;
     return v;
@@ -175,7 +178,7 @@ void App::chooseRedraw(const SceneView& view, FrameInfo& info) {
     for (int i = 0; i < kSceneCategoryCount; ++i) {
         const uint32_t c = 1u << i;
         // Time moves on with the bodies; a pass that reads it redraws all (the runtime).
-        if (c != kSceneTumblers && c != kSceneMarbles && c != kSceneTime && view.versions[i] != lastVersions_[i])
+        if (c != kSceneRoundCones && c != kSceneSpheres && c != kSceneTime && view.versions[i] != lastVersions_[i])
             onlyBodies = false;
         lastVersions_[i] = view.versions[i];
     }

@@ -18,8 +18,8 @@ SceneLook lookOf(const sim::Scene& scene) {
     look.left = glm::vec3(scene.box.left);
     look.right = glm::vec3(scene.box.right);
     look.other = glm::vec3(scene.box.other);
-    look.woodLight = glm::vec3(scene.box.floorWood.light);
-    look.woodDark = glm::vec3(scene.box.floorWood.dark);
+    look.ringsLight = glm::vec3(scene.box.floorWood.light);
+    look.ringsDark = glm::vec3(scene.box.floorWood.dark);
     look.woodRingFrequency = float(scene.box.floorWood.ringFrequency);
     look.wallEmission = glm::vec3(scene.box.emission);
     look.closed = scene.box.closed;
@@ -39,7 +39,7 @@ std::vector<BodyInstance> bodiesOf(const sim::World& world, int highlighted) {
     for (size_t i = 0; i < world.tumblers().size(); ++i) {
         const auto& t = world.tumblers()[i];
         BodyInstance b;
-        b.category = kSceneTumblers;
+        b.category = kSceneRoundCones;
         float m[16];
         t.modelMatrix(m);
         b.model = glm::make_mat4(m);
@@ -50,7 +50,7 @@ std::vector<BodyInstance> bodiesOf(const sim::World& world, int highlighted) {
     for (const auto& ball : world.balls()) {
         // The sim owns the look of a ball (burning marbles darken towards ash).
         BodyInstance b;
-        b.category = ball.kind == sim::BallKind::Fireball ? kSceneFireballs : kSceneMarbles;
+        b.category = ball.kind == sim::BallKind::Fireball ? kSceneGlowingSpheres : kSceneSpheres;
         b.model = glm::scale(glm::translate(glm::mat4(1.0f), glm::vec3(ball.position)), glm::vec3(float(ball.radius)));
         b.albedo = glm::vec3(ball.albedo());
         b.emissive = glm::vec3(ball.emissiveColor() * ball.emissiveStrength());

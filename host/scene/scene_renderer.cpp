@@ -204,7 +204,7 @@ void SceneRenderer::setLook(const SceneLook& look) {
     // The quad faces +y at y = 0; each wall is it rotated so its normal points into the room.
     const glm::mat4 I(1.0f);
     if (look.walls) {
-        wall(glm::translate(I, {0, -1, 0}), look.woodLight, 1.0f);                                           // floor
+        wall(glm::translate(I, {0, -1, 0}), look.ringsLight, 1.0f);                                           // floor
         wall(glm::rotate(glm::translate(I, {0, 1, 0}), glm::radians(180.0f), {1, 0, 0}), look.other, 0.0f);  // ceiling
         wall(glm::rotate(glm::translate(I, {-1, 0, 0}), glm::radians(-90.0f), {0, 0, 1}), look.left, 0.0f);  // left
         wall(glm::rotate(glm::translate(I, {1, 0, 0}), glm::radians(90.0f), {0, 0, 1}), look.right, 0.0f);   // right
@@ -221,8 +221,8 @@ void SceneRenderer::setLook(const SceneLook& look) {
     movedUnbounded_ = true;
     // New meshes change what every category looks like, whatever its instances say.
     for (int i = 0; i < kSceneGeometryCount; ++i) ++versions_[i], hashes_[i] = 0;
-    noteContents(kSceneBox, staticInstances_.data(), walls);
-    noteContents(kSceneLamp, staticInstances_.data() + walls, staticInstances_.size() - walls);
+    noteContents(kScenePlanes, staticInstances_.data(), walls);
+    noteContents(kSceneLightSurface, staticInstances_.data() + walls, staticInstances_.size() - walls);
     dirty_ = true;
 }
 
@@ -342,7 +342,7 @@ void SceneRenderer::noteContents(SceneCategory c, const GpuInstance* begin, size
 void SceneRenderer::setBodies(const std::vector<BodyInstance>& bodies) {
     // Grouped by category so each category is one contiguous instance range.
     bodyInstances_.clear();
-    for (SceneCategory c : {kSceneTumblers, kSceneMarbles, kSceneFireballs}) {
+    for (SceneCategory c : {kSceneRoundCones, kSceneSpheres, kSceneGlowingSpheres}) {
         const size_t first = bodyInstances_.size();
         for (auto& b : bodies)
             if (b.category == c)
@@ -361,7 +361,7 @@ void SceneRenderer::noteMovedBodies() {
     auto sphere = [&](const GpuInstance& g, size_t i) {
         const float scale = std::max({glm::length(glm::vec3(g.model[0])), glm::length(glm::vec3(g.model[1])),
                                       glm::length(glm::vec3(g.model[2]))});
-        const float meshRadius = i < count(kSceneTumblers) ? tumblerRadius_ : 1.0f;
+        const float meshRadius = i < count(kSceneRoundCones) ? tumblerRadius_ : 1.0f;
         return glm::vec4(glm::vec3(g.model[3]), scale * meshRadius);
     };
     if (!movedUnbounded_)
@@ -408,9 +408,9 @@ void SceneRenderer::chooseLevels() {
     };
     size_t first = 0;
     int k = 0;
-    for (SceneCategory c : {kSceneTumblers, kSceneMarbles, kSceneFireballs}) {
+    for (SceneCategory c : {kSceneRoundCones, kSceneSpheres, kSceneGlowingSpheres}) {
         const size_t n = count(c);
-        if (c == kSceneTumblers) {
+        if (c == kSceneRoundCones) {
             // One mesh for all: the largest on screen decides.
             float largestPx = 0.0f;
             for (size_t i = first; i < first + n; ++i) {
@@ -456,22 +456,22 @@ void SceneRenderer::rebuildGroups() {
     };
     // The order of the instance buffer: static, bodies by category (spheres near to
     // far), particles.
-    add(kQuad, kSceneBox);
-    add(kLamp, kSceneLamp);
+    add(kQuad, kScenePlanes);
+    add(kLamp, kSceneLightSurface);
     for (const MeshGroup& g : meshGroups_) {
         groups_.push_back({g.mesh, kSceneMeshes, Lod::High, true, cursor, g.instances, g.twoSided});
         cursor += g.instances;
     }
-    if (const uint32_t n = count(kSceneTumblers); n > 0) {
+    if (const uint32_t n = count(kSceneRoundCones); n > 0) {
         const MeshId camera = tumblersNear_ ? kTumblerNearMesh : kTumblerFarMesh;
-        groups_.push_back({camera, kSceneTumblers, Lod::High, false, cursor, n});
-        groups_.push_back({kTumblerNearMesh, kSceneTumblers, Lod::Fine, false, cursor, n});
-        groups_.push_back({kTumblerShadowMesh, kSceneTumblers, Lod::Medium, false, cursor, n});
-        groups_.push_back({kTumblerVoxelMesh, kSceneTumblers, Lod::Low, false, cursor, n});
+        groups_.push_back({camera, kSceneRoundCones, Lod::High, false, cursor, n});
+        groups_.push_back({kTumblerNearMesh, kSceneRoundCones, Lod::Fine, false, cursor, n});
+        groups_.push_back({kTumblerShadowMesh, kSceneRoundCones, Lod::Medium, false, cursor, n});
+        groups_.push_back({kTumblerVoxelMesh, kSceneRoundCones, Lod::Low, false, cursor, n});
         cursor += n;
     }
-    addSpheres(kSceneMarbles, sphereLevels_[0]);
-    addSpheres(kSceneFireballs, sphereLevels_[1]);
+    addSpheres(kSceneSpheres, sphereLevels_[0]);
+    addSpheres(kSceneGlowingSpheres, sphereLevels_[1]);
     add(kParticle, kSceneParticles);
 }
 

@@ -28,7 +28,7 @@ struct SceneLook {
     glm::vec3 left{0.95f, 0.45f, 0.1f};    // orange
     glm::vec3 right{0.35f, 0.65f, 0.95f};  // sky blue
     glm::vec3 other{0.85f, 0.82f, 0.78f};  // back wall, ceiling (the floor is wood)
-    glm::vec3 woodLight{0.72f, 0.52f, 0.32f}, woodDark{0.45f, 0.28f, 0.15f};
+    glm::vec3 ringsLight{0.72f, 0.52f, 0.32f}, ringsDark{0.45f, 0.28f, 0.15f};
     float woodRingFrequency = 14.0f;
     glm::vec3 wallEmission{0.0f};  // radiance every wall emits
     bool closed = false;           // a front wall at z = +1 (colour `other`)
@@ -41,7 +41,7 @@ struct SceneLook {
 };
 
 struct BodyInstance {
-    SceneCategory category = kSceneTumblers;  // tumblers, marbles, fireballs
+    SceneCategory category = kSceneRoundCones;  // tumblers, marbles, fireballs
     glm::mat4 model{1.0f};                    // for spheres: translate × scale(radius)
     glm::vec3 albedo{1.0f};
     glm::vec3 emissive{0.0f};
@@ -121,7 +121,7 @@ public:
     // The triangles draw() would issue for the filter (as uploaded).
     uint64_t triangles(const DrawFilter&) const;
     void bindInstances() const override;
-    // Instances of one geometry category (kSceneBox ... kSceneParticles).
+    // Instances of one geometry category (kScenePlanes ... kSceneParticles).
     uint32_t count(SceneCategory single) const { return counts_[sceneCategoryIndex(single)]; }
     // Changes whenever that geometry category's instance contents changed.
     uint64_t version(SceneCategory single) const { return versions_[sceneCategoryIndex(single)]; }

@@ -103,7 +103,7 @@ public:
                                   "over. 64: llvmpipe's own tiles (at 16, composite took 20.1 against 17.4 ms at "
                                   "720² moving, though it recomputed 36 % of the picture against 45 %: llvmpipe "
                                   "sets up each small triangle in each of its tiles)"));
-        d.reads = kSceneLight | kSceneCamera | kSceneFireballs;
+        d.reads = kSceneLights | kSceneCamera | kSceneGlowingSpheres;
         return d;
     }
 
@@ -248,8 +248,8 @@ private:
         glUniform1f(glGetUniformLocation(program, "u_shadowBias"), ctx.getFloat("shadow_bias"));
         glUniform1f(glGetUniformLocation(program, "u_indirectStrength"), ctx.getFloat("indirect_strength"));
         glUniform1f(glGetUniformLocation(program, "u_lampNearField"), ctx.getFloat("lamp_near_field"));
-        glUniform1i(glGetUniformLocation(program, "u_firstFireball"), int(ctx.scene().firstInstance(kiln::kSceneFireballs)));
-        glUniform1i(glGetUniformLocation(program, "u_fireballCount"), int(ctx.scene().count(kiln::kSceneFireballs)));
+        glUniform1i(glGetUniformLocation(program, "u_firstFireball"), int(ctx.scene().firstInstance(kiln::kSceneGlowingSpheres)));
+        glUniform1i(glGetUniformLocation(program, "u_fireballCount"), int(ctx.scene().count(kiln::kSceneGlowingSpheres)));
     }
 
     // Everything but the moving instances that the kept light was computed from: when
@@ -310,7 +310,7 @@ private:
         const int tilesDown = (color.height + tileSize - 1) / tileSize;
         const uint32_t tileCount = uint32_t(tilesAcross * tilesDown);
         // The particles, last in the instances, are not followed (cacheKey).
-        const uint32_t first = scene.firstInstance(kiln::kSceneTumblers), end = scene.firstInstance(kiln::kSceneParticles);
+        const uint32_t first = scene.firstInstance(kiln::kSceneRoundCones), end = scene.firstInstance(kiln::kSceneParticles);
 
         // The share of the tiles that moved at the last count the GPU has finished.
         if (countFence_ && glClientWaitSync(countFence_, 0, 0) != GL_TIMEOUT_EXPIRED) {
@@ -322,8 +322,8 @@ private:
         }
         // No instance moved since the last run (the scene paused or asleep): none of
         // the tiles would be marked.
-        const std::array<uint64_t, 3> instances{scene.version(kiln::kSceneTumblers), scene.version(kiln::kSceneMarbles),
-                                                scene.version(kiln::kSceneFireballs)};
+        const std::array<uint64_t, 3> instances{scene.version(kiln::kSceneRoundCones), scene.version(kiln::kSceneSpheres),
+                                                scene.version(kiln::kSceneGlowingSpheres)};
         if (instances == instancesSeen_) movedShare_ = 0.0;
         instancesSeen_ = instances;
         // Back from the whole at a lower share than away to it: the first run in tiles
@@ -389,7 +389,7 @@ private:
             glUniform1ui(uniform(p, "u_to"), to[part]);
             glUniform1ui(uniform(p, "u_end"), end);
             glUniform1ui(uniform(p, "u_previousEnd"), previousKept_ ? previousEnd_ : 0u);
-            glUniform1ui(uniform(p, "u_tumblersEnd"), first + scene.count(kiln::kSceneTumblers));
+            glUniform1ui(uniform(p, "u_tumblersEnd"), first + scene.count(kiln::kSceneRoundCones));
             glUniform1i(uniform(p, "u_compare"), previousKept_ ? 1 : 0);
             glUniform2i(uniform(p, "u_tiles"), tilesAcross, tilesDown);
             glUniform1i(uniform(p, "u_tileSize"), tileSize);
@@ -466,7 +466,7 @@ private:
         const int side = ctx.getInt("lamp_field_size");
         if (!lampField_ || lampField_.width() != side)
             lampField_ = kiln::gl::Texture::create(GL_TEXTURE_2D, GL_RG16F, side, side, 1, 1, "composite.lamp_field");
-        const FieldKey key{ctx.scene().version(kiln::kSceneLight), side, builder};
+        const FieldKey key{ctx.scene().version(kiln::kSceneLights), side, builder};
         if (key == builtField_) return true;
         glUseProgram(builder);
         kiln::gl::bindImage(builder, "u_field", lampField_.id(), 0, false, GL_WRITE_ONLY, GL_RG16F);

@@ -209,7 +209,7 @@ public:
                              "alpha = the lamp's unshadowed projected solid angle at each traced surface (its "
                              "silhouette's contour, 16 vertices), upsampled with the indirect light, for composite's "
                              "lamp_model traced; off: alpha = ambient visibility"));
-        d.reads = kSceneCamera | kSceneLight;
+        d.reads = kSceneCamera | kSceneLights;
         return d;
     }
 
@@ -308,7 +308,7 @@ private:
     void bindHistory(kiln::PassContext& ctx, GLuint program, int reuseFrames) {
         const kiln::SceneView& scene = ctx.scene();
         uint64_t world = kiln::kFnvOffsetBasis;
-        for (kiln::SceneCategory c : {kiln::kSceneLight, kiln::kSceneBox, kiln::kSceneLamp})
+        for (kiln::SceneCategory c : {kiln::kSceneLights, kiln::kScenePlanes, kiln::kSceneLightSurface})
             world = kiln::fnv1a(&scene.versions[kiln::sceneCategoryIndex(c)], sizeof(uint64_t), world);
         const GLuint history = ctx.internal("history").id;
         const bool fresh = world != world_ || program != program_ || history != history_;

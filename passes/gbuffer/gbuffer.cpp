@@ -67,13 +67,13 @@ public:
         // +1.6 ms at 720². Re-baked when the wood colours or the texture change.
         const kiln::TextureRef& wood = ctx.internal("wood");
         const auto& f = ctx.scene().frame;
-        if (wood.id != bakedTexture_ || f.woodLight != bakedLight_ || f.woodDark != bakedDark_ || bake != bakedWith_) {
+        if (wood.id != bakedTexture_ || f.ringsLight != bakedLight_ || f.ringsDark != bakedDark_ || bake != bakedWith_) {
             glUseProgram(bake);
             kiln::gl::bindImage(bake, "u_wood", wood.id, 0, false, GL_WRITE_ONLY, GL_RGBA8);
             glDispatchCompute(GLuint((wood.width + 7) / 8), GLuint((wood.height + 7) / 8), 1);
             glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
             glGenerateTextureMipmap(wood.id);
-            bakedTexture_ = wood.id, bakedLight_ = f.woodLight, bakedDark_ = f.woodDark, bakedWith_ = bake;
+            bakedTexture_ = wood.id, bakedLight_ = f.ringsLight, bakedDark_ = f.ringsDark, bakedWith_ = bake;
         }
         if (!ctx.framebuffer({"albedo", "normal", "emissive"}, "depth")) return;
         // Where only bodies moved, only what they change (kiln/pass.hpp): the clears
@@ -96,7 +96,7 @@ public:
             // before shading (gbuffer 5.36 -> 5.21 ms at 720², three alternations).
             glEnable(GL_CULL_FACE);
             glCullFace(GL_BACK);
-            ctx.drawScene({.categories = tracedSpheres ? kiln::kSceneTumblers : kiln::kSceneBodies});
+            ctx.drawScene({.categories = tracedSpheres ? kiln::kSceneRoundCones : kiln::kSceneBodies});
             glDisable(GL_CULL_FACE);
             if (tracedSpheres) drawTracedSpheres(ctx, sphereProgram);
             if (meshes) {
@@ -116,7 +116,7 @@ public:
             // The floor, the one wood-grained instance (a wall of the box).
             glUseProgram(woodProgram);
             kiln::gl::bindTexture(woodProgram, "u_wood", wood.id);
-            ctx.drawScene({.categories = kiln::kSceneBox});
+            ctx.drawScene({.categories = kiln::kScenePlanes});
 
             glUseProgram(background);
             glDepthMask(GL_FALSE);
@@ -163,10 +163,10 @@ private:
     // sphere_mode traced: the marbles and the fireballs (neighbours in the instance
     // buffer, which holds the categories in bit order), each its screen rectangle.
     void drawTracedSpheres(kiln::PassContext& ctx, GLuint sphereProgram) {
-        const uint32_t count = ctx.scene().count(kiln::kSceneMarbles | kiln::kSceneFireballs);
+        const uint32_t count = ctx.scene().count(kiln::kSceneSpheres | kiln::kSceneGlowingSpheres);
         if (count == 0) return;
         glUseProgram(sphereProgram);
-        glUniform1ui(glGetUniformLocation(sphereProgram, "u_first"), ctx.scene().firstInstance(kiln::kSceneMarbles));
+        glUniform1ui(glGetUniformLocation(sphereProgram, "u_first"), ctx.scene().firstInstance(kiln::kSceneSpheres));
         glBindVertexArray(emptyVertexArray());
         glDrawArrays(GL_TRIANGLES, 0, GLsizei(6 * count));
         glBindVertexArray(0);

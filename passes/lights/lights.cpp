@@ -20,7 +20,7 @@ public:
                          "GpuPunctualLight::color.w), depth through its shadowViewProj"})
             .param(intChoiceParam("shadow_size", 1024, {256, 512, 1024, 2048}, "texels a side of each light's tile"))
             .param(floatParam("slope_bias", 2.0f, 0.0, 10.0, "polygon offset factor against shadow acne"));
-        d.reads = kSceneStatic | kSceneMeshes | kSceneShadowCasters | kSceneLight;
+        d.reads = kSceneStatic | kSceneMeshes | kSceneShadowCasters | kSceneLights;
         return d;
     }
 
@@ -71,8 +71,8 @@ private:
                                               {"KILN_HAS_COLOR_LAYERS", scene.materialTextures[0] ? "1" : "0"}}})
                    : 0;
         if (meshes && !cutout) return false;
-        const StaticKey key{{scene.version(kiln::kSceneBox), scene.version(kiln::kSceneLamp),
-                             scene.version(kiln::kSceneMeshes), scene.version(kiln::kSceneLight)},
+        const StaticKey key{{scene.version(kiln::kScenePlanes), scene.version(kiln::kSceneLightSurface),
+                             scene.version(kiln::kSceneMeshes), scene.version(kiln::kSceneLights)},
                             program, cutout, side, ctx.getFloat("slope_bias"), scene.materialTextures[0]};
         if (key == built_ && staticAtlas_) return true;
         if (!staticAtlas_ || !framebuffer_ || staticAtlas_.height() != side) {

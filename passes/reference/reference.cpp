@@ -34,7 +34,7 @@ public:
             .param(intParam("roulette_start", 3, 0, 256, "bounce from which Russian roulette may end a path"))
             .param(intParam("seed", 1, 0, 1 << 30, "random sequence; the same seed gives the same image"))
             .param(boolParam("jitter", true, "integrate over each pixel's area (off: through pixel centres)"));
-        d.reads = kSceneGeometry | kSceneLight | kSceneCamera;
+        d.reads = kSceneGeometry | kSceneLights | kSceneCamera;
         d.timeDependent = true;  // accumulates every frame; resets itself on change
         return d;
     }

@@ -37,7 +37,7 @@ public:
                              "the casters' meshes: fine (the finest: tumblers at 48 slices, 32-segment spheres), "
                              "medium (24 slices, 16-segment spheres), coarse (the voxelizer's: 8, 10) or auto: "
                              "medium up to a 1024² map"));
-        d.reads = kSceneShadowCasters | kSceneMeshes | kSceneLight;
+        d.reads = kSceneShadowCasters | kSceneMeshes | kSceneLights;
         return d;
     }
 
@@ -82,7 +82,7 @@ private:
                                             .defines = {{"KILN_HAS_COLOR_LAYERS", scene.materialTextures[0] ? "1" : "0"}}});
         if (!program) return false;
         const int side = ctx.getInt("size");
-        const StaticKey key{scene.version(kiln::kSceneMeshes), scene.version(kiln::kSceneLight), program, side,
+        const StaticKey key{scene.version(kiln::kSceneMeshes), scene.version(kiln::kSceneLights), program, side,
                             ctx.getFloat("slope_bias"), scene.materialTextures[0]};
         if (key == built_ && staticDepth_) return true;
         if (!staticDepth_ || !framebuffer_ || staticDepth_.width() != side) {

@@ -169,7 +169,7 @@ public:
                                   "cover and tests the fireballs against the cap: 16³ cost 1.5 ms at 720² on "
                                   "llvmpipe, 8³ 0.4). The lamp is large, so the fraction changes slowly away "
                                   "from the fire"));
-        d.reads = kSceneStatic | kSceneMeshes | kSceneBodies | kSceneParticles | kSceneLight;
+        d.reads = kSceneStatic | kSceneMeshes | kSceneBodies | kSceneParticles | kSceneLights;
         return d;
     }
 
@@ -235,7 +235,7 @@ public:
         // The particles' cover and the transmittance grid from it: the resolve reads the grid.
         if (fireCover) coverFire(ctx, coverer, fireResolve, fireMip, fireLight, res);
         rasterize(ctx, raster, res, !keepStatic, particles && !splatParticles, !splatFireballs, !splatTumblers);
-        if (fireballSplatter) splat(ctx, fireballSplatter, kFireballGroup, res, kiln::kSceneFireballs);
+        if (fireballSplatter) splat(ctx, fireballSplatter, kFireballGroup, res, kiln::kSceneGlowingSpheres);
         if (particleSplatter) splat(ctx, particleSplatter, kParticleGroup, res, kiln::kSceneParticles);
         if (tumblerSplatter) splatTumblerShapes(ctx, tumblerSplatter, res);
         resolveSums(ctx, resolve, out, res);
@@ -251,8 +251,8 @@ private:
         const kiln::SceneView& scene = ctx.scene();
         // The debug view edits a parameter on the same object: the two the voxels depend
         // on are in the key (lamp_model and fire_cover change the programs).
-        const StaticKey key{scene.version(kiln::kSceneLamp), scene.version(kiln::kSceneLight),
-                            scene.version(kiln::kSceneBox), scene.version(kiln::kSceneMeshes), scene.frame.woodLight, scene.frame.woodDark,
+        const StaticKey key{scene.version(kiln::kSceneLightSurface), scene.version(kiln::kSceneLights),
+                            scene.version(kiln::kScenePlanes), scene.version(kiln::kSceneMeshes), scene.frame.ringsLight, scene.frame.ringsDark,
                             staticSums.id, raster, recorder, res, ctx.getFloat("lamp_emission"),
                             ctx.getBool("conservative")};
         if (key == builtStatic_) return true;
@@ -274,7 +274,7 @@ private:
             beginRaster(ctx, recorder, res, staticSums.id);
             glUniform1f(glGetUniformLocation(recorder, "u_emissionScale"), 1.0f);
             glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kStaticBinding, staticFragments_.id());
-            ctx.drawScene({.categories = kiln::kSceneBox | kiln::kSceneMeshes, .lod = kiln::Lod::Low});
+            ctx.drawScene({.categories = kiln::kScenePlanes | kiln::kSceneMeshes, .lod = kiln::Lod::Low});
             glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
             glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
                             GL_BUFFER_UPDATE_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
@@ -330,7 +330,7 @@ private:
     static void drawDome(kiln::PassContext& ctx, GLuint raster) {
         glUniform1f(glGetUniformLocation(raster, "u_emissionScale"), ctx.getFloat("lamp_emission"));
         glUniform1i(glGetUniformLocation(raster, "u_unshadowed"), 1);
-        ctx.drawScene({.categories = kiln::kSceneLamp, .lod = kiln::Lod::Low});
+        ctx.drawScene({.categories = kiln::kSceneLightSurface, .lod = kiln::Lod::Low});
     }
 
     // 1–3: the box and the lamp (unless kept), the tumblers and whatever is not splatted,
@@ -341,15 +341,15 @@ private:
         if (rasterStatic) drawDome(ctx, raster);
         const GLint emissionScale = glGetUniformLocation(raster, "u_emissionScale");
         glUniform1i(glGetUniformLocation(raster, "u_unshadowed"), 0);
-        uint32_t cats = (rasterStatic ? kiln::kSceneBox | kiln::kSceneMeshes : 0u) | (rasterTumblers ? kiln::kSceneTumblers : 0u);
+        uint32_t cats = (rasterStatic ? kiln::kScenePlanes | kiln::kSceneMeshes : 0u) | (rasterTumblers ? kiln::kSceneRoundCones : 0u);
         if (rasterParticles) cats |= kiln::kSceneParticles;
-        if (ctx.getBool("marbles")) cats |= kiln::kSceneMarbles;
+        if (ctx.getBool("marbles")) cats |= kiln::kSceneSpheres;
         glUniform1f(emissionScale, 1.0f);
         ctx.drawScene({.categories = cats, .lod = kiln::Lod::Low});
         if (rasterFireballs) {
             glUniform1f(emissionScale, ctx.getFloat("fireball_emission"));
             glUniform1i(glGetUniformLocation(raster, "u_sphereFlux"), ctx.getBool("fireball_flux") ? 1 : 0);
-            ctx.drawScene({.categories = kiln::kSceneFireballs, .lod = kiln::Lod::Low});
+            ctx.drawScene({.categories = kiln::kSceneGlowingSpheres, .lod = kiln::Lod::Low});
             glUniform1i(glGetUniformLocation(raster, "u_sphereFlux"), 0);
         }
         glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
@@ -414,8 +414,8 @@ private:
         glUseProgram(lighter);
         kiln::gl::bindTexture(lighter, "u_fire", fire.id);
         kiln::gl::bindImage(lighter, "u_transmittance", light.id, 0, true, GL_WRITE_ONLY, GL_R16F);
-        glUniform1i(glGetUniformLocation(lighter, "u_firstFireball"), GLint(scene.firstInstance(kiln::kSceneFireballs)));
-        glUniform1i(glGetUniformLocation(lighter, "u_fireballCount"), GLint(scene.count(kiln::kSceneFireballs)));
+        glUniform1i(glGetUniformLocation(lighter, "u_firstFireball"), GLint(scene.firstInstance(kiln::kSceneGlowingSpheres)));
+        glUniform1i(glGetUniformLocation(lighter, "u_fireballCount"), GLint(scene.count(kiln::kSceneGlowingSpheres)));
         const GLuint lightGroups = GLuint((light.width + 3) / 4);
         glDispatchCompute(lightGroups, lightGroups, lightGroups);
         glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
@@ -439,13 +439,13 @@ private:
     // from the axis' midpoint), a row of groups per tumbler.
     static void splatTumblerShapes(kiln::PassContext& ctx, GLuint program, int res) {
         const kiln::SceneView& scene = ctx.scene();
-        const uint32_t tumblers = scene.count(kiln::kSceneTumblers);
+        const uint32_t tumblers = scene.count(kiln::kSceneRoundCones);
         if (tumblers == 0) return;
-        const glm::vec4& shape = scene.frame.tumblerShape;
+        const glm::vec4& shape = scene.frame.roundCone;
         const float reach = 0.5f * shape.w + shape.x, voxel = 2.0f * scene.frame.voxelVolume.w / float(res);
         const int side = std::min(res, int(std::ceil(2.0f * reach / voxel)) + 1);  // +1: the cube starts at a floor
         useSurfaceProgram(ctx, program, res);
-        glUniform1ui(glGetUniformLocation(program, "u_first"), scene.firstInstance(kiln::kSceneTumblers));
+        glUniform1ui(glGetUniformLocation(program, "u_first"), scene.firstInstance(kiln::kSceneRoundCones));
         glUniform1i(glGetUniformLocation(program, "u_side"), side);
         glDispatchCompute(GLuint((side * side * side + 63) / 64), tumblers, 1);
     }
@@ -477,7 +477,7 @@ private:
         GLuint builder = ctx.program({.stages = {"common/lamp_field.comp"}, .defines = {{"KILN_LAMP_SAMPLES", "16"}}});
         if (!builder) return false;
         const kiln::TextureRef& field = ctx.internal("lamp_field");
-        const FieldKey key{ctx.scene().version(kiln::kSceneLight), field.id, builder};
+        const FieldKey key{ctx.scene().version(kiln::kSceneLights), field.id, builder};
         if (key == builtField_) return true;
         glUseProgram(builder);
         kiln::gl::bindImage(builder, "u_field", field.id, 0, false, GL_WRITE_ONLY, GL_RG16F);
@@ -496,7 +496,7 @@ private:
     // module reload starts over).
     struct StaticKey {
         uint64_t lampVersion = 0, lightVersion = 0, boxVersion = 0, meshesVersion = 0;
-        glm::vec4 woodLight{-1.0f}, woodDark{-1.0f};  // the floor's grain (its albedo)
+        glm::vec4 ringsLight{-1.0f}, ringsDark{-1.0f};  // the floor's grain (its albedo)
         GLuint texture = 0, program = 0, recorder = 0;
         int resolution = 0;
         float emission = -1.0f;

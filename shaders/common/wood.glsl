@@ -1,6 +1,6 @@
 // A procedural wood grain for the floor: growth rings around a log axis running
 // along x below the floor, warped by value noise, between the scene file's light and
-// dark wood colours (u_woodLight, u_woodDark from common/frame.glsl; include it first).
+// dark wood colours (u_ringsLight, u_ringsDark from common/frame.glsl; include it first).
 // The lattice point's hash from integer arithmetic alone (a two-round permuted
 // congruential mix), so every driver bakes the same grain: fract(sin(x) * 43758.5) at
 // x in the hundreds rests on each driver's sin there, and NVIDIA's floor differed from
@@ -23,7 +23,7 @@ float kilnNoise(vec2 p) {
 vec3 woodGrain(vec3 world) {
     vec2 p = world.xz;
     float warp = kilnNoise(p * vec2(1.5, 6.0)) * 0.6 + kilnNoise(p * vec2(6.0, 24.0)) * 0.15;
-    float r = length(vec2(p.y * 3.0, 1.7)) * u_woodLight.w + warp * 3.0 + p.x * 0.8;
+    float r = length(vec2(p.y * 3.0, 1.7)) * u_ringsLight.w + warp * 3.0 + p.x * 0.8;
     float ring = smoothstep(0.0, 0.6, abs(fract(r) - 0.5) * 2.0);
-    return mix(u_woodDark.rgb, u_woodLight.rgb, ring);
+    return mix(u_ringsDark.rgb, u_ringsLight.rgb, ring);
 }

@@ -72,9 +72,9 @@ void instanceBox(KilnInstance inst, bool tumbler, out vec3 lo, out vec3 hi) {
         lo = m[3].xyz - scale, hi = m[3].xyz + scale;
         return;
     }
-    vec3 upper = (m * vec4(0.0, u_tumblerShape.w, 0.0, 1.0)).xyz;
-    lo = min(m[3].xyz - scale * u_tumblerShape.x, upper - scale * u_tumblerShape.y);
-    hi = max(m[3].xyz + scale * u_tumblerShape.x, upper + scale * u_tumblerShape.y);
+    vec3 upper = (m * vec4(0.0, u_roundCone.w, 0.0, 1.0)).xyz;
+    lo = min(m[3].xyz - scale * u_roundCone.x, upper - scale * u_roundCone.y);
+    hi = max(m[3].xyz + scale * u_roundCone.x, upper + scale * u_roundCone.y);
 }
 
 // Where a caster's shadow can have changed: on what lies in the pyramid from the map's
@@ -133,7 +133,7 @@ void markShadow(vec3 lo, vec3 hi) {
     // The lamp's dome, where a caster reaches below its lowest point.
     if (top > u_lightPos.y - u_lightPos.w) markWorldBox(u_lightPos.xyz - u_lightPos.w, u_lightPos.xyz + u_lightPos.w);
     for (int wall = 0; wall < 6; ++wall)
-        if ((u_boxWalls.x & (1u << wall)) != 0u) markWallInPyramid(wall >> 1, (wall & 1) == 0 ? -1.0 : 1.0);
+        if ((u_closedFaces.x & (1u << wall)) != 0u) markWallInPyramid(wall >> 1, (wall & 1) == 0 ? -1.0 : 1.0);
     // The instances inside: each tests the recorded pyramids (KILN_PART 2).
     uint k = atomicAdd(pyramidCount, 1u);
     if (k < pyramidBoxes.length() / 2) pyramidBoxes[2u * k] = vec4(boxLo, 0.0), pyramidBoxes[2u * k + 1u] = vec4(boxHi, 0.0);

@@ -38,7 +38,7 @@ vec3 insideBlock(vec3 p01, float al) {
 // The share of a lookup at p01 on a level of `side` texels that lies inside the box or
 // behind a wall: trilinear filtering with an empty border on the open faces.
 float insideBox(vec3 p01, float side) {
-    uint walls = u_boxWalls.x;
+    uint walls = u_closedFaces.x;
     vec3 wallBelow = vec3(uvec3(walls, walls >> 2, walls >> 4) & 1u);
     vec3 wallAbove = vec3(uvec3(walls >> 1, walls >> 3, walls >> 5) & 1u);
     vec3 below = max(clamp(p01 * side + 0.5, 0.0, 1.0), wallBelow);

@@ -2,7 +2,7 @@
 // (common/instances.glsl), read as exact shapes instead of meshes.
 //   box walls   the quad (y = 0, |x|, |z| ≤ 1, normal +y) placed by the instance's model
 //   lamp        the sphere u_lightPos below the ceiling y = 1 (its instance: material)
-//   tumblers    the round cone u_tumblerShape placed by the model (rigid)
+//   tumblers    the round cone u_roundCone placed by the model (rigid)
 //   spheres     marbles, fireballs, particles: model = translate × scale(radius)
 // Ranges come from the host's category counts (u_first/u_count, SceneView order).
 #include "common/frame.glsl"
@@ -42,8 +42,8 @@ float sphereEntry(vec3 o, vec3 d, vec3 c, float r, float tMin) {
 // the convex hull is the union of both balls and the frustum between the tangent
 // circles, so the first hit is the nearest first hit of the three.
 float roundConeHit(vec3 o, vec3 d, float tMin, out vec3 normal) {
-    const float b = u_tumblerShape.x, tr = u_tumblerShape.y, yt = u_tumblerShape.w;
-    const float sa = sin(u_tumblerShape.z), ca = cos(u_tumblerShape.z);
+    const float b = u_roundCone.x, tr = u_roundCone.y, yt = u_roundCone.w;
+    const float sa = sin(u_roundCone.z), ca = cos(u_roundCone.z);
     float best = kNoHit;
     float t0 = sphereEntry(o, d, vec3(0.0), b, tMin);
     if (t0 < best) best = t0, normal = (o + t0 * d) / b;
@@ -99,8 +99,8 @@ Hit traceScene(vec3 o, vec3 d, float tMin) {
     for (int i = u_first[kTumblers]; i < u_first[kTumblers] + u_count[kTumblers]; ++i) {
         mat4 m = kiln_instances[i].model;
         // Bounding sphere first: the cone's axis midpoint, radius half the height + b.
-        vec3 mid = (m * vec4(0.0, 0.5 * u_tumblerShape.w, 0.0, 1.0)).xyz;
-        float reach = 0.5 * u_tumblerShape.w + u_tumblerShape.x;
+        vec3 mid = (m * vec4(0.0, 0.5 * u_roundCone.w, 0.0, 1.0)).xyz;
+        float reach = 0.5 * u_roundCone.w + u_roundCone.x;
         vec3 om = o - mid;
         float bb = dot(om, d);
         if (bb * bb - dot(om, om) + reach * reach < 0.0) continue;

@@ -1,6 +1,6 @@
 #version 450 core
 // Voxelization of the tumblers without their meshes (voxelize.tumbler_mode splat): their
-// exact shape, the round cone of u_tumblerShape placed by each instance's model (the
+// exact shape, the round cone of u_roundCone placed by each instance's model (the
 // shape the reference traces), instead of the low-poly mesh through the geometry
 // shader. Invocation (x, y) takes voxel x of the cube of u_side³ voxels around tumbler
 // y's bounding ball; where the surface passes through that voxel it adds one fragment
@@ -32,8 +32,8 @@ uniform int u_side;    // voxels per side of each tumbler's cube
 // the nearest surface point. Which part is nearest follows from p's coordinate along
 // the side's generator (as the reference's roundConeHit bounds the side).
 float roundConeDistance(vec3 p, out vec3 gradient) {
-    float b = u_tumblerShape.x, t = u_tumblerShape.y, yt = u_tumblerShape.w;
-    float sa = sin(u_tumblerShape.z), ca = cos(u_tumblerShape.z);
+    float b = u_roundCone.x, t = u_roundCone.y, yt = u_roundCone.w;
+    float sa = sin(u_roundCone.z), ca = cos(u_roundCone.z);
     float r = length(p.xz);
     vec2 q = vec2(r, p.y);
     float along = dot(q, vec2(-sa, ca));
@@ -59,8 +59,8 @@ void main() {
     mat3 toLocal = transpose(mat3(m));  // rigid
     float voxel = kilnVoxelSize(float(u_res));
     // The bounding ball: the axis' midpoint, half the height plus the lower radius.
-    vec3 mid = (m * vec4(0.0, 0.5 * u_tumblerShape.w, 0.0, 1.0)).xyz;
-    float reach = 0.5 * u_tumblerShape.w + u_tumblerShape.x;
+    vec3 mid = (m * vec4(0.0, 0.5 * u_roundCone.w, 0.0, 1.0)).xyz;
+    float reach = 0.5 * u_roundCone.w + u_roundCone.x;
     ivec3 lo = ivec3(floor(kilnVolumeTexcoord(mid - reach) * float(u_res)));
     ivec3 v = lo + ivec3(cell % u_side, (cell / u_side) % u_side, cell / (u_side * u_side));
     if (any(lessThan(v, ivec3(0))) || any(greaterThanEqual(v, ivec3(u_res)))) return;

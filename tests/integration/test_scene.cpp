@@ -680,7 +680,7 @@ TEST_CASE("scene renderer: the particles reach the instance buffer far to near a
         renderer.bindInstances();
         GLint buffer = 0;
         glGetIntegeri_v(GL_SHADER_STORAGE_BUFFER_BINDING, GLuint(kInstanceBinding), &buffer);
-        const uint32_t first = renderer.count(kSceneBox) + renderer.count(kSceneLamp);
+        const uint32_t first = renderer.count(kScenePlanes) + renderer.count(kSceneLightSurface);
         REQUIRE(renderer.count(kSceneParticles) == 6);
         std::vector<GpuInstance> got(6);
         glGetNamedBufferSubData(GLuint(buffer), GLintptr(first * sizeof(GpuInstance)), GLsizeiptr(6 * sizeof(GpuInstance)),
@@ -722,7 +722,7 @@ TEST_CASE("tumbler level of detail: the camera takes the far mesh while every tu
     const uint64_t nearMesh = trianglesOf(scene::kTumblerNear), farMesh = trianglesOf(scene::kTumblerFar),
                    shadowMesh = trianglesOf(scene::kTumblerShadow);
     REQUIRE(farMesh < nearMesh);
-    auto drawn = [&](kiln::Lod lod) { return renderer.triangles({.categories = kSceneTumblers, .lod = lod}); };
+    auto drawn = [&](kiln::Lod lod) { return renderer.triangles({.categories = kSceneRoundCones, .lod = lod}); };
     const glm::vec3 eye(0.0f, 0.0f, 3.0f), forward(0.0f, 0.0f, -1.0f);
     const float bounding = scene::tumblerBoundingRadius(look.tumblerB, look.tumblerT, look.tumblerAlpha);
     const float threshold = scene::kTumblerNearPx / bounding * 3.0f;  // pixels a unit at which one at 3 m is near

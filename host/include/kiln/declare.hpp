@@ -141,26 +141,30 @@ struct ParamDecl {
     std::string doc;
 };
 
-// Parts of the scene. One set of bits serves two purposes: a pass's `reads` (the host
-// re-runs it only when one of these, its inputs or its parameters changed, unless it
-// is time-dependent) and drawScene()'s filter (the geometry bits).
+// Parts of the scene model. One set of bits serves two purposes: a pass's `reads` (the
+// host re-runs it only when one of these, its inputs or its parameters changed, unless
+// it is time-dependent) and drawScene()'s filter (the geometry bits). Geometry comes in
+// static parts (planes, the area light's surface, placed meshes) and moving bodies of
+// three shapes; a scene source fills whichever it has and leaves the rest empty.
 enum SceneCategory : uint32_t {
     kSceneNone = 0,
-    kSceneBox = 1u << 0,        // the five walls (the floor carries the wood grain)
-    kSceneLamp = 1u << 1,       // the emissive dome under the ceiling
-    kSceneMeshes = 1u << 2,     // static meshes a scene file places (glTF models), with their
-                                //   materials and textures (SceneView::materialTextures)
-    kSceneTumblers = 1u << 3,
-    kSceneMarbles = 1u << 4,
-    kSceneFireballs = 1u << 5,
-    kSceneParticles = 1u << 6,
-    kSceneLight = 1u << 7,      // the lamp's position, size and radiance
+    kScenePlanes = 1u << 0,        // static quads (unit squares placed by their model), each
+                                   //   a plain albedo or the procedural rings material
+    kSceneLightSurface = 1u << 1,  // the spherical area light's visible surface (a cap)
+    kSceneMeshes = 1u << 2,        // static triangle meshes (glTF models), with their
+                                   //   materials and textures (SceneView::materialTextures)
+    kSceneRoundCones = 1u << 3,    // moving round cones (GpuFrame::roundCone), shadow casters
+    kSceneSpheres = 1u << 4,       // moving spheres, shadow casters
+    kSceneGlowingSpheres = 1u << 5,  // moving emissive spheres: they emit, they cast no shadow
+    kSceneParticles = 1u << 6,     // point emitters, drawn as small spheres
+    kSceneLights = 1u << 7,        // the area light's position, size and radiance; the
+                                   //   punctual lights
     kSceneCamera = 1u << 8,
     kSceneTime = 1u << 9,
 
-    kSceneStatic = kSceneBox | kSceneLamp,
-    kSceneBodies = kSceneTumblers | kSceneMarbles | kSceneFireballs,
-    kSceneShadowCasters = kSceneTumblers | kSceneMarbles,  // the moving casters; fireballs emit, they don't cast
+    kSceneStatic = kScenePlanes | kSceneLightSurface,
+    kSceneBodies = kSceneRoundCones | kSceneSpheres | kSceneGlowingSpheres,
+    kSceneShadowCasters = kSceneRoundCones | kSceneSpheres,  // the moving casters
     kSceneGeometry = 0x7f,      // what drawScene() can draw
     kSceneAll = 0x3ff,
 };

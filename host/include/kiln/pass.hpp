@@ -62,7 +62,7 @@
 //   params     name, type, default, range or choices: they drive the JSON validation
 //              and the debug UI. Read them in execute() with ctx.getFloat("name") etc.
 //   reads      the scene categories you read (SceneCategory in kiln/declare.hpp:
-//              kSceneMeshes, kSceneShadowCasters, kSceneBodies, kSceneLight, kSceneCamera,
+//              kSceneMeshes, kSceneShadowCasters, kSceneBodies, kSceneLights, kSceneCamera,
 //              ...). The geometry bits are also what ctx.drawScene() filters on.
 //
 // SKIPPING
@@ -78,8 +78,8 @@
 //   extend them, so a paused frame settles and then costs nothing again.
 //
 // REDRAWING PART OF THE PICTURE
-//   When the only change since your last run is bodies moving (a marble rolling among
-//   sleeping tumblers, nothing else), the host hands you the part of the picture they
+//   When the only change since your last run is bodies moving (one sphere rolling
+//   among bodies at rest, nothing else), the host hands you the part of the picture they
 //   can change: ctx.frame().redraw, up to two rectangles in output pixels (the moved
 //   bodies' footprints with their shadows and nearby light, and one band of rows that
 //   moves down the picture each such frame, so light that changes a little everywhere
@@ -88,15 +88,15 @@
 //   only those rectangles (kiln::forEachRedrawRect sets the scissor for each, scaled
 //   to your target; kiln::redrawRects gives them to a compute dispatch). A pass that
 //   fills a screen-sized output from a neighbourhood of its inputs grows them by its
-//   reach. frame().redrawCount is 0 whenever anything else changed (the camera, the
-//   lamp, a parameter, a program, a size, time for a pass that reads it, a pass before
+//   reach. frame().redrawCount is 0 whenever anything else changed (the camera, a
+//   light, a parameter, a program, a size, time for a pass that reads it, a pass before
 //   yours still converging, your last run failed): redraw everything. Ignoring it is
 //   always correct, only slower.
 //
 // REUSING WHAT DID NOT CHANGE
 //   A pass may keep what it computed from an input and redo only where instances
 //   moved, while that input's TextureRef::setup is the one it last saw: then nothing
-//   but the scene's instances changed upstream (the camera, the lamp, the box, time,
+//   but the scene's instances changed upstream (the camera, the lights, static geometry, time,
 //   parameters, programs and sizes did not). Where the movement reaches depends on the
 //   producer (gbuffer: the instances' own pixels; shadow: the casters' texels; voxels:
 //   the light they bounce, everywhere), so such a pass says which producers it assumes
@@ -127,7 +127,7 @@
 //   includes "common/scene.glsl" for the attributes and the instance buffer.
 //   ctx.drawFullscreenTriangle() for screen passes: vertex shader
 //   "common/fullscreen.vert", which hands the fragment shader `in vec2 v_uv` (0..1).
-//   The frame uniforms (camera, lamp, output size, time, the floor's wood) are bound as
+//   The frame uniforms (camera, lights, output size, time, bounds, materials) are bound as
 //   "common/frame.glsl" expects. The host wraps each pass in a KHR_debug group and
 //   times it (GPU timestamps + CPU clock).
 //
@@ -164,8 +164,8 @@
 //   Where there is no GPU (CI, Mesa's llvmpipe) a shader runs 8 pixels or invocations
 //   at a time, and an `if`, a `?:` or a loop body runs for all 8 whichever way they go:
 //   a branch on a uniform or on the data saves nothing, and a lookup behind it is paid
-//   everywhere (the floor's wood lookup behind `if`: 3.2 ms of the G-buffer's 9.9 at
-//   720²). Choose what runs with defines (ctx.program's .defines, one variant per case)
+//   everywhere (a procedural material's lookup behind `if`: a third of a G-buffer's
+//   time at 720²). Choose what runs with defines (ctx.program's .defines, one variant per case)
 //   or by drawing each variant over only what needs it, not with branches. Each texture
 //   lookup costs about a millisecond at 720²: a pass gets cheaper by fewer lookups a
 //   pixel, not by cheaper arithmetic — and by narrower texels: an RGBA32F fetch cost
@@ -222,13 +222,15 @@ namespace kiln {
 
 // Bump when anything in this header (or what it includes) changes layout or vtables,
 // or when what the host does for a pass changes (6: the host issues the barrier
-// between passes; 7: GpuFrame::boxWalls; 8: PassContext::keepRunning; 9:
+// between passes; 7: GpuFrame's closed faces; 8: PassContext::keepRunning; 9:
 // SizeRule::capSource and Lod::Medium; 10: ProgramBuild::portability; 11:
-// FrameInfo::redraw; 12: TextureRef::setup; 13: Lod::Fine, and Lod::High's tumblers by
-// their size on screen; 14: PassContext::isRead and TextureDecl::onlyWhenRead; 15:
+// FrameInfo::redraw; 12: TextureRef::setup; 13: Lod::Fine, and Lod::High's round cones
+// by their size on screen; 14: PassContext::isRead and TextureDecl::onlyWhenRead; 15:
 // kSceneMeshes (the bits after it moved up), GpuInstance's material fields and
-// SceneView::materialTextures; 16: GpuFrame::voxelVolume), so a module built for
-// other terms is refused by name, not run.
+// SceneView::materialTextures; 16: GpuFrame::voxelVolume, and the scene model's names:
+// kScenePlanes, kSceneLightSurface, kSceneRoundCones, kSceneSpheres,
+// kSceneGlowingSpheres, kSceneLights, GpuFrame::ringsLight/ringsDark, roundCone,
+// closedFaces), so a module built for other terms is refused by name, not run.
 inline constexpr uint32_t kPassAbiVersion = 16;
 
 struct TextureRef {
@@ -238,9 +240,9 @@ struct TextureRef {
     int width = 0, height = 0, depth = 1, levels = 1;
     bool bound = false;         // false: a fallback texture stands in
     // Changes whenever the producer (or a pass before it) wrote this texture for any
-    // reason but instances moving (tumblers, marbles, fireballs, particles): a
-    // parameter, a program, a size, a reload, a failed run, the camera, the lamp, the
-    // box, time, a pass still converging (keepRunning). While it is unchanged, the
+    // reason but instances moving (the bodies, particles): a parameter, a program, a
+    // size, a reload, a failed run, the camera, a light, static geometry, time, a pass
+    // still converging (keepRunning). While it is unchanged, the
     // texture differs from when you last read it only through instances that moved
     // (REUSING WHAT DID NOT CHANGE). 0 for a fallback.
     uint64_t setup = 0;

@@ -1,5 +1,5 @@
 // kiln/scene_view.hpp — what a pass sees of the scene: the frame uniforms (camera,
-// lamp, output size, time), how many instances of each kind there are, and a version
+// lights, output size, time, bounds), how many instances of each kind there are, and a version
 // per SceneCategory (kiln/declare.hpp) so the host can skip passes whose inputs did
 // not change. Built by the host once per frame, in one place (host/app/app.cpp);
 // read-only for passes.
@@ -14,17 +14,17 @@
 
 namespace kiln {
 
-// High: as fine as the camera's picture needs (marbles and fireballs pick one of three
-// sphere meshes per instance by their size on screen, the tumblers one of two by the
-// largest's); Low: the coarse meshes, for passes that see the scene at low resolution
-// (voxelize); Medium: every body at its middle mesh (tumblers 24 slices, spheres 16
-// segments), for a view of middling resolution that is not the camera's (the shadow
-// map); Fine: every body at its finest mesh whatever the camera sees (a large shadow
-// map).
+// How finely the moving bodies are meshed. High: as fine as the camera's picture needs
+// (each sphere picks one of three meshes by its size on screen, the round cones one of
+// two by the largest's); Low: the coarse meshes, for passes that see the scene at low
+// resolution (voxelize); Medium: every body at its middle mesh (round cones 24 slices,
+// spheres 16 segments), for a view of middling resolution that is not the camera's (a
+// shadow map); Fine: every body at its finest mesh whatever the camera sees (a large
+// shadow map).
 enum class Lod : uint8_t { High, Low, Medium, Fine };
 
 // What drawScene() draws: the geometry bits of SceneCategory (kSceneGeometry,
-// kSceneShadowCasters, kSceneTumblers | kSceneMarbles, ...) at a level of detail.
+// kSceneShadowCasters, kSceneRoundCones | kSceneSpheres, ...) at a level of detail.
 // Which of the placed meshes (kSceneMeshes) by their material's sides: one-sided ones
 // may be drawn with back faces culled, double-sided ones not. Other categories are
 // drawn whatever it says.
@@ -42,7 +42,7 @@ struct alignas(16) GpuInstance {
     glm::mat4 model;
     glm::vec4 albedo;    // rgb: the mean albedo (a textured surface's averaged over its texture,
                          //   for passes that see the scene coarsely), a = material (0 plain,
-                         //   1 wood grain)
+                         //   1 the procedural rings of GpuFrame::ringsLight/ringsDark)
     glm::vec4 emissive;  // rgb: the mean emitted radiance (already × strength), a = highlight
                          //   (picked) 0/1
     // The placed meshes' materials (kSceneMeshes; other categories leave these at their
@@ -77,21 +77,23 @@ struct GpuPunctualLight {
 struct GpuFrame {
     glm::mat4 view, proj, viewProj, invViewProj;
     glm::vec4 cameraPos;     // xyz, w unused
-    glm::vec4 lightPos;      // xyz = lamp centre (outside the box), w = lamp radius
+    glm::vec4 lightPos;      // the spherical area light: xyz centre, w radius (0: none)
     glm::vec4 lightColor;    // rgb × intensity, w = intensity
     glm::vec4 outputSize;    // w, h, 1/w, 1/h
     glm::vec4 time;          // seconds, dt, frame index, unused
-    glm::vec4 woodLight;     // the floor's wood grain (scene file box.floor_wood):
-    glm::vec4 woodDark;      //   rgb light / dark, woodLight.w = rings per metre
-    glm::vec4 tumblerShape;  // the tumblers' round cone (kiln/sim/shape.hpp): lower radius
-                             //   b, upper radius t, half-angle α (rad), upper centre y_t
-    glm::uvec4 boxWalls;     // x: the faces of the box [-1,1]³ that hold a wall, bit 2a for
-                             //   −axis a, 2a+1 for +axis a (the open Cornell box: all but +z)
+    glm::vec4 ringsLight;    // the procedural rings material (GpuInstance::albedo.a = 1):
+    glm::vec4 ringsDark;     //   rgb light / dark, ringsLight.w = rings per metre
+    glm::vec4 roundCone;     // the shape of every kSceneRoundCones instance, in its model
+                             //   space: lower sphere radius b at the origin, upper radius t
+                             //   at (0, y_t, 0), half-angle α (rad): (b, t, α, y_t)
+    glm::uvec4 closedFaces;  // x: the voxel volume's faces closed by a wall in its outermost
+                             //   voxels (a cone that reaches one stops), bit 2a for −axis a,
+                             //   2a+1 for +axis a; 0: every face open
     glm::vec4 sceneMin;      // the scene's bounds (every instance's, world space); w unused
     glm::vec4 sceneMax;
-    glm::vec4 voxelVolume{0.0f, 0.0f, 0.0f, 1.0f};  // the cube the voxel passes cover (voxelVolumeAround): xyz its
-                             //   centre, w half its side, world space; shaders map through
-                             //   kilnWorldToVolume and kin (shaders/common/frame.glsl)
+    // The cube the voxel passes cover (voxelVolumeAround): xyz its centre, w half its
+    // side, world space; shaders map through kilnWorldToVolume and kin (frame.glsl).
+    glm::vec4 voxelVolume{0.0f, 0.0f, 0.0f, 1.0f};
     glm::uvec4 punctualCount;  // x: lights[0 .. x) hold punctual lights
     GpuPunctualLight punctual[kMaxPunctualLights];
 };
@@ -105,8 +107,8 @@ inline glm::vec4 voxelVolumeAround(glm::vec3 lo, glm::vec3 hi) {
     return glm::vec4(0.5f * (lo + hi), side);
 }
 
-// GpuFrame::boxWalls.x of a box with or without its front wall (z = +1).
-constexpr uint32_t boxWallBits(bool closed) { return closed ? 0x3Fu : 0x1Fu; }
+// GpuFrame::closedFaces.x of a volume closed on every face, or on all but +z.
+constexpr uint32_t closedFaceBits(bool closed) { return closed ? 0x3Fu : 0x1Fu; }
 
 // The host camera's clip planes (GpuFrame::proj): what a pass that rasterises from the
 // camera declares as its depth output's depthNear/depthFar (the texture viewer
@@ -117,7 +119,7 @@ inline constexpr float kCameraNear = 0.05f, kCameraFar = 20.0f;
 inline constexpr unsigned kFrameBinding = 0;      // uniform block
 inline constexpr unsigned kInstanceBinding = 0;   // shader storage block
 
-// Bit index of a single SceneCategory bit (kSceneTumblers → 2); -1 for a mask.
+// Bit index of a single SceneCategory bit (kSceneRoundCones → 3); -1 for a mask.
 constexpr int sceneCategoryIndex(uint32_t c) {
     for (int i = 0; i < kSceneCategoryCount; ++i)
         if (c == (1u << i)) return i;
@@ -131,19 +133,20 @@ struct SceneView {
     // space); layers chosen by GpuInstance::layers. 0 when the scene has none.
     uint32_t materialTextures[2] = {0, 0};
     // Bumped by the host whenever that category changed (geometry: its instance
-    // contents; light: the lamp; camera: the view-projection; time: a step).
+    // contents; lights: a light; camera: the view-projection; time: a step).
     uint64_t versions[kSceneCategoryCount] = {};
     uint32_t counts[kSceneGeometryCount] = {};  // instances per geometry category
 
-    // The instance buffer holds the geometry categories in bit order (box walls, lamp,
-    // tumblers, marbles, fireballs, particles); this is where `single` starts.
+    // The instance buffer holds the geometry categories in bit order (planes, the light's
+    // surface, meshes, round cones, spheres, glowing spheres, particles); this is where
+    // `single` starts.
     uint32_t firstInstance(SceneCategory single) const {
         uint32_t n = 0;
         for (int i = 0; i < sceneCategoryIndex(single); ++i) n += counts[i];
         return n;
     }
     uint64_t version(SceneCategory single) const { return versions[sceneCategoryIndex(single)]; }
-    // Instances in the geometry categories of `mask` (kSceneShadowCasters: tumblers + marbles).
+    // Instances in the geometry categories of `mask` (kSceneShadowCasters: round cones + spheres).
     uint32_t count(uint32_t mask) const {
         uint32_t n = 0;
         for (int i = 0; i < kSceneGeometryCount; ++i)
