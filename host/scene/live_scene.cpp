@@ -124,10 +124,11 @@ bool LiveScene::load(const std::string& sceneFile, std::optional<uint64_t> seed,
     }
     std::vector<PlacedModel> models;
     if (!loadModels(scene, sceneFile, models, error)) return false;
-    // A model with lights of its own is shown alone, lit by them; one without stands in
-    // the box under its lamp.
+    // A model with lights of its own is shown alone, lit by them, at its own size (the
+    // voxel volume follows it); one without stands in the box under its lamp, fitted.
     if (isGltfFile(sceneFile) && !models[0].model->lights.empty()) {
         scene.box.walls = false;
+        scene.models[0].fit = false;
         models[0].placement = placementOf(scene.models[0], *models[0].model, false);
     }
     if (seed) scene.physics.seed = *seed;
