@@ -177,7 +177,8 @@ public:
             .param(intChoiceParam("cones", 6, {1, 5, 6, 9, 16},
                                   "diffuse cones per pixel, around the normal (with fixed_cones bound: 6, the fixed set)"))
             .param(floatParam("aperture", 60.0f, 5.0, 150.0, "cone opening angle, degrees"))
-            .param(floatParam("max_distance", 2.0f, 0.1, 3.5, "cone length, world units (box side = 2)"))
+            .param(floatParam("max_distance", 2.0f, 0.1, 3.5,
+                              "cone length in the voxel volume's units (its side = 2, whatever the scene's size)"))
             .param(enumParam("schedule", "octave", {"octave", "continuous"},
                              "octave: one lookup per mip level (integral lods); continuous: spacing = step"))
             .param(floatParam("step", 1.0f, 0.2, 2.0, "continuous schedule: spacing in cone diameters"))
