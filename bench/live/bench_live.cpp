@@ -132,7 +132,7 @@ int main(int argc, char** argv) {
     fs::create_directories(outDir);
     std::ofstream csv(fs::path(outDir) / "live.csv");
     csv << "edit,trial,ms\n";
-    std::printf("save-to-new-frame latency, 720x720 headless, %d trials (watcher debounce 50 ms)\n", trials);
+    std::printf("save-to-new-frame latency, 720x720 headless, %d trials (a save is read at the next frame)\n", trials);
     std::printf("  %-15s %10s %10s\n", "edit", "median ms", "max ms");
     for (auto& [name, ms] : results) {
         for (size_t i = 0; i < ms.size(); ++i) csv << name << "," << i << "," << ms[i] << "\n";

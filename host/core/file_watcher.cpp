@@ -102,9 +102,9 @@ bool FileWatcher::isWatched(const fs::path& dir) const {
     return false;
 }
 
-void FileWatcher::noteEvent(const fs::path& file) {
+void FileWatcher::noteEvent(const fs::path& file, bool complete) {
     if (isNoise(file.filename().string())) return;
-    pending_[file] = Clock::now();
+    pending_[file] = complete ? Clock::now() : Clock::now() + debounce_;
 }
 
 void FileWatcher::rescan() {
@@ -178,7 +178,8 @@ void FileWatcher::readEvents() {
                 continue;
             }
             // IN_CREATE alone may be a half-written file: wait for CLOSE_WRITE.
-            if ((e->mask & (IN_CLOSE_WRITE | IN_MOVED_TO)) && dir->second.covers(path)) noteEvent(path);
+            // Closed after writing or renamed into place: the file is whole, due now.
+            if ((e->mask & (IN_CLOSE_WRITE | IN_MOVED_TO)) && dir->second.covers(path)) noteEvent(path, true);
         }
     }
 }
@@ -187,7 +188,7 @@ std::vector<fs::path> FileWatcher::settledChanges() {
     std::vector<fs::path> settled;
     const auto now = Clock::now();
     for (auto it = pending_.begin(); it != pending_.end();) {
-        if (now - it->second < debounce_) {
+        if (now < it->second) {
             ++it;
             continue;
         }

@@ -94,3 +94,44 @@ TEST_CASE("a directory watched recursively reports its subdirectories' files too
     CHECK(contains(reported, root / "notes.txt"));
     CHECK(contains(reported, root / "scene.json"));
 }
+
+TEST_CASE("a file closed after writing or renamed into place is read at once, one still being written is not",
+          "[live]") {
+    // A debounce of an hour: whatever is reported within the tests' deadline was reported
+    // for its event, not after a quiet interval.
+    WatchedTree tree("complete");
+    FileWatcher watcher(std::chrono::hours(1));
+    REQUIRE(watcher.usingInotify());
+    REQUIRE(watcher.watch(tree.root));
+    const fs::path root = fs::weakly_canonical(tree.root);
+
+    // Written in place and closed.
+    tree.write("scene.json", "{\"in place\": 1}");
+    CHECK(contains(pollUntilReported(watcher, root / "scene.json"), root / "scene.json"));
+
+    // Written to a temporary name and renamed over it, as many editors save.
+    tree.write("sub/deep.json.tmp", "{\"renamed\": 1}");
+    fs::rename(tree.root / "sub/deep.json.tmp", tree.root / "sub/deep.json");
+    CHECK(contains(pollUntilReported(watcher, root / "sub/deep.json"), root / "sub/deep.json"));
+
+    // Half written and still open: not reported. inotify keeps its events in order, so
+    // once a file closed after it is reported, every event of the open file was read.
+    {
+        std::ofstream open(tree.root / "scene.json", std::ios::trunc);
+        open << "{\"half\": ";
+        open.flush();
+        tree.write("notes.txt", "a later file, closed");
+        const std::vector<fs::path> reported = pollUntilReported(watcher, root / "notes.txt");
+        CHECK(contains(reported, root / "notes.txt"));
+        CHECK_FALSE(contains(reported, root / "scene.json"));
+        open << "2}";
+    }  // closed: now whole
+    CHECK(contains(pollUntilReported(watcher, root / "scene.json"), root / "scene.json"));
+
+    // Saved again with the same bytes: nothing to reload (a closed file, so reported at
+    // once had it changed; the later file below shows its event was read).
+    tree.write("scene.json", "{\"half\": 2}");
+    tree.write("notes.txt", "and another");
+    const std::vector<fs::path> afterTouch = pollUntilReported(watcher, root / "notes.txt");
+    CHECK_FALSE(contains(afterTouch, root / "scene.json"));
+}

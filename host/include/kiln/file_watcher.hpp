@@ -1,11 +1,13 @@
 // kiln/file_watcher.hpp — one watcher for shaders, pipelines, scenes and modules.
 //
 // inotify on directories (a watch on a file is lost when an editor saves by rename),
-// recursive or one directory alone, polled without blocking once per frame on the render thread: no thread,
-// no locks, and changes apply at a frame boundary by construction. A path is
-// reported once it has been quiet for the debounce interval (trailing edge) and only
-// if its content changed (FNV-1a of the bytes), so a burst of saves is one reload
-// and a touch is none. Editor noise (.swp, 4913, *~, dot-files) is ignored. On queue
+// recursive or one directory alone, polled without blocking once per frame on the render
+// thread: no thread, no locks, and changes apply at a frame boundary by construction. A
+// file closed after writing or renamed into place (IN_CLOSE_WRITE, IN_MOVED_TO: it is
+// whole) is reported at the next poll; one only seen to differ (a rescan after a queue
+// overflow, a root that came back, polling mode: it may be mid-write) once it has been
+// quiet for the debounce interval. Either only if its content changed (FNV-1a of the
+// bytes), so the saves of a burst between two polls are one reload and a touch is none. Editor noise (.swp, 4913, *~, dot-files) is ignored. On queue
 // overflow every known file is re-hashed; a directory deleted and recreated (git
 // checkout) is re-added — a watched root too (checked every 250 ms while it is gone),
 // its files then compared with what they held before it went. Where inotify cannot be used, the same interface polls
@@ -37,7 +39,7 @@ public:
     // Returns false if it does not exist.
     enum class Depth { Recursive, ThisDirectory };
     bool watch(const std::filesystem::path& dir, Depth depth = Depth::Recursive, const std::string& extension = {});
-    // Files whose content changed and that have been quiet for the debounce interval.
+    // Files whose content changed and that are due (see the top of this file).
     std::vector<std::filesystem::path> poll();
     bool usingInotify() const { return fd_ >= 0; }
 
@@ -61,9 +63,9 @@ private:
     // reported if its content changed.
     void addDirectory(const Watched& how, bool firstSight = true);
     bool isWatched(const std::filesystem::path& dir) const;
-    void noteEvent(const std::filesystem::path& file);
+    void noteEvent(const std::filesystem::path& file, bool complete = false);
     void readEvents();  // drains inotify without blocking
-    // Pending paths quiet for the debounce interval whose content changed.
+    // Pending paths now due whose content changed.
     std::vector<std::filesystem::path> settledChanges();
     void rescan();
     static bool isNoise(const std::string& name);
@@ -73,7 +75,7 @@ private:
     std::vector<Watched> roots_;
     std::map<int, Watched> watches_;  // inotify wd → directory
     std::map<std::filesystem::path, Known> known_;  // every file seen, by content hash
-    std::map<std::filesystem::path, Clock::time_point> pending_;  // path → last event
+    std::map<std::filesystem::path, Clock::time_point> pending_;  // path → when it is due
     Clock::time_point lastScan_{};
     Clock::time_point lastRootCheck_{};
 };
