@@ -23,8 +23,7 @@ glm::ivec2 texelOf(glm::vec2 uv, int width, int height) {
 // camera's planes; none when the pixel sees nothing (depth at the far plane).
 void findWorld(const std::vector<run::NamedTexture>& textures, const glm::mat4& invViewProj, PixelTrace& trace) {
     for (const run::NamedTexture& t : textures) {
-        if (t.ref.target != GL_TEXTURE_2D || !gl::isDepthFormat(t.ref.format) || t.depthNear != kCameraNear ||
-            t.depthFar != kCameraFar)
+        if (t.ref.target != GL_TEXTURE_2D || !gl::isDepthFormat(t.ref.format) || !t.cameraDepth)
             continue;
         trace.depthTexture = t.pass + "." + t.name;
         const glm::ivec2 texel = texelOf(trace.uv, t.ref.width, t.ref.height);

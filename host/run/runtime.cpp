@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <fstream>
 #include <sstream>
 
@@ -335,6 +336,11 @@ void Runtime::renderFrame(const SceneView& view, const SceneDraw& scene, const F
     frame.outputWidth = options_.width;
     frame.outputHeight = options_.height;
     GpuFrame gpuFrame = view.frame;
+    // A perspective projection's far plane: proj[3][2] / (proj[2][2] + 1) (glm::perspective).
+    if (const glm::mat4& p = view.frame.proj; p[2][3] == -1.0f && p[2][2] != -1.0f) {
+        const float far = p[3][2] / (p[2][2] + 1.0f);
+        if (std::isfinite(far) && far > 0.0f) cameraFar_ = far;
+    }
     gpuFrame.outputSize = {float(options_.width), float(options_.height), 1.0f / float(options_.width),
                            1.0f / float(options_.height)};
     gpuFrame.time = {float(frame.time), float(frame.dt), float(frame.index), 0.0f};
@@ -497,7 +503,7 @@ std::optional<NamedTexture> Runtime::namedTexture(std::string_view qualified) co
         auto it = s->textures.find(qualified.substr(dot + 1));
         if (it == s->textures.end()) return std::nullopt;
         const PooledTexture& t = it->second;
-        return NamedTexture{s->id, it->first, t.internal, t.ref, t.decl.depthNear, t.decl.depthFar, t.decl.size.tiles};
+        return named(s->id, it->first, t);
     }
     return std::nullopt;
 }
@@ -512,6 +518,14 @@ std::vector<PassRow> Runtime::stats() const {
     return rows;
 }
 
+NamedTexture Runtime::named(const std::string& pass, const std::string& name, const PooledTexture& t, bool read,
+                            bool stale) const {
+    NamedTexture n{pass, name, t.internal, t.ref, t.decl.depthNear, t.decl.depthFar, t.decl.size.tiles, read, stale};
+    n.cameraDepth = t.decl.depthNear == kCameraNear && t.decl.depthFar == kCameraFar;
+    if (n.cameraDepth) n.depthFar = cameraFar_;
+    return n;
+}
+
 std::vector<NamedTexture> Runtime::textures() const {
     std::vector<NamedTexture> out;
     for (size_t i = 0; i < slots_.size(); ++i) {
@@ -519,8 +533,7 @@ std::vector<NamedTexture> Runtime::textures() const {
         const graph::PlannedPass* planned = plan_ && i < plan_->passes.size() ? &plan_->passes[i] : nullptr;
         for (auto& [name, t] : s.textures) {
             const bool read = !planned || t.internal || readEverything || planned->outputIsRead(name);
-            out.push_back({s.id, name, t.internal, t.ref, t.decl.depthNear, t.decl.depthFar, t.decl.size.tiles, read,
-                           !read && t.decl.onlyWhenRead});
+            out.push_back(named(s.id, name, t, read, !read && t.decl.onlyWhenRead));
         }
     }
     return out;

@@ -158,6 +158,9 @@ private:
     std::map<std::string, std::string> externalErrors_;
     std::set<std::string> faultedModules_;  // this frame's, recovered after it
     GLint frameGroupDepth_ = 0;             // KHR_debug group depth when the passes start
+    float cameraFar_ = kCameraFar;          // the last frame's far plane (GpuFrame::proj)
+    NamedTexture named(const std::string& pass, const std::string& name, const PooledTexture& t, bool read = true,
+                       bool stale = false) const;
 };
 
 }  // namespace kiln::run

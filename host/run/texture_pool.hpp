@@ -73,6 +73,10 @@ struct NamedTexture {
     int tiles = 1;                             // blocks side by side along x (SizeRule::tiles)
     bool read = true;    // false: an output nothing reads this frame (PassContext::isRead)
     bool stale = false;  // unread, and declared onlyWhenRead: not written this frame
+    // Declared with the host camera's planes (kCameraNear, kCameraFar): the camera's
+    // depth. depthFar is then the camera's far plane of the last frame, which reaches
+    // past kCameraFar in a scene larger than the box.
+    bool cameraDepth = false;
 };
 
 // Writes `image`, read back from a texture of `internalFormat`, as BASE.png (clamped to

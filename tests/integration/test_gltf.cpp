@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/app.hpp"
+#include "app/pixel_trace.hpp"
 #include "kiln/image_io.hpp"
 #include "support/headless.hpp"
 #include "support/run_kiln.hpp"
@@ -666,4 +667,22 @@ TEST_CASE("the atrium, 37 m across: the sun on the court as E·ρ/π, the galler
     // more than 3 %; a volume that misses the hall gives 0).
     CHECK(std::abs(above - aboveBounce) < 0.02f * expected);
     CHECK(aboveBounce > 0.03f * floor);
+
+    // The camera sees past the box's 20 m here: the depth the texture viewer linearises
+    // and the pixel trace reads carries this frame's far plane, and the trace finds the
+    // court floor behind its pixel.
+    const std::vector<run::NamedTexture> textures = rig.app.runtime().textures();
+    const auto depth = std::find_if(textures.begin(), textures.end(),
+                                    [](const run::NamedTexture& t) { return t.pass == "gbuffer" && t.name == "depth"; });
+    REQUIRE(depth != textures.end());
+    CHECK(depth->cameraDepth);
+    CHECK(depth->depthFar == Approx(rig.app.camera().farPlane).epsilon(1e-4));
+    CHECK(depth->depthFar > kCameraFar);
+    const glm::vec2 uv = (glm::vec2(rig.pixelOf(court)) + 0.5f) / float(kSize);
+    const app::PixelTrace trace = app::tracePixel(rig.app.runtime(), glm::inverse(rig.app.viewProj()),
+                                                  rig.app.voxelVolume(), uv);
+    REQUIRE(trace.world);
+    INFO("traced " << trace.world->x << " " << trace.world->y << " " << trace.world->z);
+    CHECK(std::abs(trace.world->y) < 0.01f);  // on the floor
+    CHECK(glm::length(glm::vec2(trace.world->x, trace.world->z)) < 1.0f);  // the pixel's footprint at a grazing view
 }
