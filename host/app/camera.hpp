@@ -17,7 +17,7 @@ struct Camera {
     float fovY = 0.6632f;    // 38°: the box opening just fills a square view
     glm::vec3 target{0.0f};  // orbit: what it circles
     glm::vec3 eye{0.0f};     // fly: where it is
-    float farPlane = kCameraFar;  // farther for a scene larger than the box (App::init)
+    float farPlane = kCameraFar;  // farther for a scene larger than the box (App::buildView)
 
     glm::vec3 position() const;
     glm::vec3 forward() const;  // unit: where it looks

@@ -7,10 +7,11 @@
 // whole) is reported at the next poll; one only seen to differ (a rescan after a queue
 // overflow, a root that came back, polling mode: it may be mid-write) once it has been
 // quiet for the debounce interval. Either only if its content changed (FNV-1a of the
-// bytes), so the saves of a burst between two polls are one reload and a touch is none. Editor noise (.swp, 4913, *~, dot-files) is ignored. On queue
-// overflow every known file is re-hashed; a directory deleted and recreated (git
-// checkout) is re-added — a watched root too (checked every 250 ms while it is gone),
-// its files then compared with what they held before it went. Where inotify cannot be used, the same interface polls
+// bytes), so the saves of a burst between two polls are one reload and a touch is none.
+// Editor noise (.swp, 4913, *~, dot-files) is ignored. On queue overflow every known file
+// is re-hashed; a directory deleted and recreated (git checkout) is re-added — a watched
+// root too (checked every 250 ms while it is gone), its files then compared with what
+// they held before it went. Where inotify cannot be used, the same interface polls
 // (nanosecond mtime + size + inode) at most every 100 ms.
 #pragma once
 

@@ -103,8 +103,8 @@ struct GpuFrame {
 // A scene of [-1,1]³ gets exactly that cube.
 inline glm::vec4 voxelVolumeAround(glm::vec3 lo, glm::vec3 hi) {
     const glm::vec3 half = 0.5f * (hi - lo);
-    const float side = std::max(std::max(half.x, half.y), std::max(half.z, 1e-3f));
-    return glm::vec4(0.5f * (lo + hi), side);
+    const float halfSide = std::max(std::max(half.x, half.y), std::max(half.z, 1e-3f));
+    return glm::vec4(0.5f * (lo + hi), halfSide);
 }
 
 // GpuFrame::closedFaces.x of a volume closed on every face, or on all but +z.
