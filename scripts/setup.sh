@@ -8,6 +8,8 @@ packages=(
   python3-glad                       # glad 2: generates the GL loader at configure time
   libglfw3-dev libimgui-dev          # window + debug view
   libglm-dev nlohmann-json3-dev libstb-dev catch2
+  libcli11-dev                       # every program's command line
+  help2man                           # the man page, from kiln --help
   libtinyexr-dev                     # OpenEXR read/write for HDR textures (--dump, reference cache)
   libtinygltf-dev                    # glTF 2.0 scenes (host/model)
   libmeshoptimizer-dev               # their meshes ordered for the vertex cache

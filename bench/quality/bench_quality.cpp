@@ -65,6 +65,7 @@
 #include "kiln/log.hpp"
 #include "metrics.hpp"
 #include <kiln/plot_script.hpp>
+#include "command_line/command_line.hpp"
 #include "support/bench_support.hpp"
 
 namespace fs = std::filesystem;
@@ -107,63 +108,40 @@ struct Args {
 };
 
 [[noreturn]] void usageError(const std::string& message) {
-    std::fprintf(stderr, "kiln-bench-quality: error: %s\n", message.c_str());
+    std::fprintf(stderr, "kiln-bench-quality: error: %s (see kiln-bench-quality --help)\n", message.c_str());
     std::exit(2);
 }
 
 Args parseArgs(int argc, char** argv) {
     Args args;
-    for (int i = 1; i < argc; ++i) {
-        const std::string a = argv[i];
-        auto next = [&]() -> std::string {
-            if (i + 1 >= argc) usageError(a + " needs a value");
-            return argv[++i];
-        };
-        auto positive = [&](const std::string& v) {
-            char* end = nullptr;
-            const long n = std::strtol(v.c_str(), &end, 10);
-            if (*end || n < 1 || n > 1 << 20) usageError(a + " " + v + ": expected a positive integer");
-            return int(n);
-        };
-        // Files are checked here: the reference renders before any pipeline loads, for
-        // minutes.
-        auto file = [&]() {
-            std::string path = next();
-            if (!fs::is_regular_file(path)) usageError(a + " " + path + ": cannot read the file");
-            return path;
-        };
-        if (a == "--pipeline") args.pipeline = file();
-        else if (a == "--also") args.also.push_back(file());
-        else if (a == "--scene") args.scene = file();
-        else if (a == "--time") {
-            const std::string v = next();
-            char* end = nullptr;
-            args.time = std::strtod(v.c_str(), &end);
-            if (*end || !std::isfinite(args.time) || args.time < 0 || args.time > 3600) usageError("--time " + v + ": expected seconds in [0, 3600]");
-        } else if (a == "--size") {
-            const std::string v = next();
-            if (std::sscanf(v.c_str(), "%dx%d", &args.width, &args.height) != 2 || args.width < 8 || args.height < 8 ||
-                args.width > 4096 || args.height > 4096)
-                usageError("--size " + v + ": expected WxH between 8 and 4096");
-        } else if (a == "--spp") {
-            args.spp = positive(next());
-            if (args.spp % 2) usageError("--spp " + std::to_string(args.spp) + ": expected an even count (two halves of N/2 paths)");
-        } else if (a == "--frames") args.frames = positive(next());
-        else if (a == "--repeats") args.repeats = positive(next());
-        else if (a == "--cartesian") args.cartesian = true;
-        else if (a == "--images") args.images = true;
-        else if (a == "--sweep") args.sweeps.push_back(next());
-        else if (a == "--out") args.outDir = next();
-        else if (a == "--cache") args.cacheDir = next();
-        else if (a == "--help" || a == "-h") {
-            std::printf("usage: kiln-bench-quality [--pipeline FILE] [--also FILE]... [--scene FILE] [--time S] [--size WxH] [--spp N]\n"
-                        "                          [--frames N] [--repeats R] [--sweep PASS.PARAM=V1,V2,...]... [--cartesian]\n"
-                        "                          [--out DIR] [--cache DIR] [--images]\n"
-                        "  --images  also write OUT/images/: each setting's composite.hdr and its indirect part,\n"
-                        "            and the reference's mean and indirect part (OpenEXR, linear radiance)\n");
-            std::exit(0);
-        } else usageError("unknown argument \"" + a + "\"");
-    }
+    CLI::App app{"kiln-bench-quality — run time against error: each setting's frame time and its noise-corrected\n"
+                 "error against a path-traced reference (two independent halves); the reference, most of the\n"
+                 "run, is cached for the next. Writes OUT/quality.csv and its plot.",
+                 "kiln-bench-quality"};
+    cli::configure(app);
+    // Files are checked here: the reference renders before any pipeline loads, for minutes.
+    const CLI::Validator readable(
+        [](std::string& path) { return fs::is_regular_file(path) ? std::string() : path + ": cannot read the file"; }, "");
+    app.add_option("--pipeline", args.pipeline, "the pipeline measured (default pipelines/default.json)")
+        ->type_name("FILE")->check(readable);
+    app.add_option("--also", args.also, "another pipeline, measured as it is (repeatable)")
+        ->type_name("FILE")->check(readable)->allow_extra_args(false);
+    app.add_option("--scene", args.scene, "the scene (default scenes/cornell.json)")->type_name("FILE")->check(readable);
+    app.add_option("--time", args.time, "the simulated moment measured, in seconds (default 0.5)")
+        ->type_name("S")->check(CLI::Range(0.0, 3600.0));
+    cli::addSize(app, "--size", args.width, args.height, 8, 4096, "the picture's size (default 128x128)");
+    app.add_option("--spp", args.spp, "reference paths per pixel, an even count: two halves (default 256)")
+        ->type_name("N")->check(CLI::Range(2, 1 << 20));
+    app.add_option("--frames", args.frames, "timed frames per setting (default 5)")->type_name("N")->check(CLI::Range(1, 1 << 20));
+    app.add_option("--repeats", args.repeats, "timing repeats, the median kept (default 3)")->type_name("N")->check(CLI::Range(1, 1 << 20));
+    app.add_option("--sweep", args.sweeps, "a knob's values, each measured on its own (repeatable; default: the shipped knobs)")
+        ->type_name("PASS.PARAM=V1,V2")->allow_extra_args(false);
+    app.add_flag("--cartesian", args.cartesian, "every combination of the sweeps, not one knob at a time");
+    app.add_flag("--images", args.images, "also write OUT/images/: each setting's HDR frame and indirect part, and the reference's");
+    app.add_option("--out", args.outDir, "where the CSV, plot and images go (default bench-out)")->type_name("DIR");
+    app.add_option("--cache", args.cacheDir, "where references are cached (default OUT/cache)")->type_name("DIR");
+    if (const std::optional<int> exitNow = cli::parse(app, argc, argv)) std::exit(*exitNow);
+    if (args.spp % 2) std::exit(cli::usageError(app, "--spp " + std::to_string(args.spp) + ": expected an even count (two halves of N/2 paths)"));
     if (args.sweeps.empty()) args.sweeps.assign(std::begin(kDefaultSweeps), std::end(kDefaultSweeps));
     return args;
 }

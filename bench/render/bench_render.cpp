@@ -39,6 +39,7 @@
 #include "app/context.hpp"
 #include "kiln/gl.hpp"
 #include "kiln/log.hpp"
+#include "command_line/command_line.hpp"
 #include "support/bench_support.hpp"
 
 namespace fs = std::filesystem;
@@ -69,65 +70,51 @@ struct Args {
 };
 
 [[noreturn]] void usageError(const std::string& message) {
-    std::fprintf(stderr, "kiln-bench-render: error: %s\n", message.c_str());
+    std::fprintf(stderr, "kiln-bench-render: error: %s (see kiln-bench-render --help)\n", message.c_str());
     std::exit(2);
 }
 
 Args parseArgs(int argc, char** argv) {
     Args args;
-    for (int i = 1; i < argc; ++i) {
-        std::string a = argv[i];
-        auto next = [&]() -> std::string {
-            if (i + 1 >= argc) usageError(a + " needs a value");
-            return argv[++i];
-        };
-        if (a == "--pipeline") args.pipelines.push_back(next());
-        else if (a == "--size") {
-            std::string v = next();
-            if (std::sscanf(v.c_str(), "%dx%d", &args.width, &args.height) != 2 || args.width < 1 || args.height < 1)
-                usageError("--size " + v + ": expected WxH");
-        } else if (a == "--frames") args.frames = std::max(1, std::atoi(next().c_str()));
-        else if (a == "--repeats") args.repeats = std::max(1, std::atoi(next().c_str()));
-        else if (a == "--out") args.outDir = next();
-        else if (a == "--sweep") args.sweeps.push_back(next());
-        else if (a == "--scene") args.scene = next();
-        else if (a == "--settle") {
-            args.settle = std::atof(next().c_str());
-            if (!(args.settle >= 0 && args.settle <= 60)) usageError("--settle: expected seconds in [0, 60]");
-        } else if (a == "--steps-per-frame") {
-            args.stepsPerFrame = std::atoi(next().c_str());
-            if (args.stepsPerFrame < 1 || args.stepsPerFrame > kMaxStepsPerFrame)
-                usageError("--steps-per-frame: expected 1 to " + std::to_string(kMaxStepsPerFrame));
-        } else if (a == "--grow") {
-            const std::string v = next();
-            const size_t eq = v.find('=');
-            args.growKind = v.substr(0, eq);
-            if (eq == std::string::npos || (args.growKind != "fireballs" && args.growKind != "marbles"))
-                usageError("--grow " + v + ": expected fireballs=N1,N2,... or marbles=N1,N2,...");
-            std::stringstream counts(v.substr(eq + 1));
-            std::string c;
-            while (std::getline(counts, c, ',')) {
-                char* end = nullptr;
-                const long n = std::strtol(c.c_str(), &end, 10);
-                if (c.empty() || *end || n < 0 || n > 1000) usageError("--grow " + v + ": counts are integers in [0, 1000]");
-                args.growCounts.push_back(int(n));
-            }
-        }
-        else if (a == "--set") {
-            Override o;
-            std::string error;
-            if (!parseOverride(next(), o, error)) usageError("--set " + error);
-            args.sets.push_back(o);
-        } else if (a == "--help" || a == "-h") {
-            std::printf("usage: kiln-bench-render [--pipeline FILE]... [--scene FILE] [--size WxH] [--frames N]\n"
-                        "                         [--repeats R] [--settle SECONDS] [--steps-per-frame N]\n"
-                        "                         [--set PASS.PARAM=JSON]...\n"
-                        "                         [--sweep PASS.PARAM=V1,V2,...]...\n"
-                        "                         | [--grow fireballs|marbles=N1,N2,...]\n"
-                        "                         [--out DIR]\n");
-            std::exit(0);
-        } else {
-            usageError("unknown argument \"" + a + "\"");
+    CLI::App app{"kiln-bench-render — each pipeline's frame time per pass (GPU timer queries and CPU), with the\n"
+                 "scene moving in real time; --sweep measures a knob's values, --grow a scene of more and more\n"
+                 "bodies. Writes OUT/render.csv (and the sweep's or growth's CSV and plot).",
+                 "kiln-bench-render"};
+    cli::configure(app);
+    app.add_option("--pipeline", args.pipelines, "a pipeline to time (repeatable; default pipelines/default.json)")
+        ->type_name("FILE")->allow_extra_args(false);
+    app.add_option("--scene", args.scene, "the scene (default scenes/cornell.json)")->type_name("FILE");
+    cli::addSize(app, "--size", args.width, args.height, 1, 16384, "the picture's size (default 720x720)");
+    app.add_option("--frames", args.frames, "timed frames per repeat (default 20)")->type_name("N")->check(CLI::Range(1, 1 << 20));
+    app.add_option("--repeats", args.repeats, "repeats, the median kept (default 3)")->type_name("N")->check(CLI::Range(1, 1 << 20));
+    app.add_option("--settle", args.settle, "simulated seconds before timing (default 1.5)")->type_name("S")->check(CLI::Range(0.0, 60.0));
+    app.add_option("--steps-per-frame", args.stepsPerFrame, "physics steps of 1/240 s a frame (default 8: real time at 30 fps)")
+        ->type_name("N")->check(CLI::Range(1, kMaxStepsPerFrame));
+    std::vector<std::string> sets;
+    app.add_option("--set", sets, "a parameter over every pipeline's value (repeatable)")->type_name("PASS.PARAM=JSON")->allow_extra_args(false);
+    app.add_option("--sweep", args.sweeps, "a knob's values, each timed on its own (repeatable)")
+        ->type_name("PASS.PARAM=V1,V2")->allow_extra_args(false);
+    std::string grow;
+    app.add_option("--grow", grow, "time the scene with that many fireballs or marbles")->type_name("fireballs|marbles=N1,N2");
+    app.add_option("--out", args.outDir, "where the CSV and plots go (default bench-out)")->type_name("DIR");
+    if (const std::optional<int> exitNow = cli::parse(app, argc, argv)) std::exit(*exitNow);
+    for (const std::string& set : sets) {
+        Override o;
+        std::string error;
+        if (!parseOverride(set, o, error)) usageError("--set " + error);
+        args.sets.push_back(o);
+    }
+    if (!grow.empty()) {
+        const size_t eq = grow.find('=');
+        args.growKind = grow.substr(0, eq);
+        if (eq == std::string::npos || (args.growKind != "fireballs" && args.growKind != "marbles"))
+            usageError("--grow " + grow + ": expected fireballs=N1,N2,... or marbles=N1,N2,...");
+        std::stringstream counts(grow.substr(eq + 1));
+        for (std::string c; std::getline(counts, c, ',');) {
+            char* end = nullptr;
+            const long n = std::strtol(c.c_str(), &end, 10);
+            if (c.empty() || *end || n < 0 || n > 1000) usageError("--grow " + grow + ": counts are integers in [0, 1000]");
+            args.growCounts.push_back(int(n));
         }
     }
     // A grown scene is measured at the pipeline's settings (and --set's): a sweep beside

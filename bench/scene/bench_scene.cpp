@@ -25,6 +25,7 @@
 #include "app/app.hpp"
 #include "app/context.hpp"
 #include "app/editable_copy.hpp"
+#include "command_line/command_line.hpp"
 #include "kiln/log.hpp"
 #include "model/model.hpp"
 
@@ -209,16 +210,6 @@ int grow(const std::string& spec, int width, int height, int frames, const std::
     return 0;
 }
 
-[[noreturn]] void usage(int code) {
-    std::fprintf(code ? stderr : stdout,
-                 "usage: kiln-bench-scene [--size WxH] [--trials N] [--out DIR] FILE.gltf|FILE.glb...\n"
-                 "       kiln-bench-scene [--size WxH] [--trials N] --grow triangles=N1,N2,...|lights=N1,N2,...\n"
-                 "  load: parse, check and flatten the file; first frame: scene load, upload and the\n"
-                 "  default pipeline's first frame; save->pixels: a material's colour saved until the\n"
-                 "  centre pixel changes. A few seconds a file at 256x256 with 10 trials.\n");
-    std::exit(code);
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -226,22 +217,19 @@ int main(int argc, char** argv) {
     std::string outDir = "bench-out";
     std::vector<std::string> files;
     std::string growSpec;
-    for (int i = 1; i < argc; ++i) {
-        const std::string a = argv[i];
-        auto next = [&]() -> std::string {
-            if (i + 1 >= argc) usage(2);
-            return argv[++i];
-        };
-        if (a == "--help" || a == "-h") usage(0);
-        else if (a == "--size") {
-            if (std::sscanf(next().c_str(), "%dx%d", &width, &height) != 2 || width < 16 || height < 16) usage(2);
-        } else if (a == "--trials") trials = std::max(2, std::atoi(next().c_str()));
-        else if (a == "--out") outDir = next();
-        else if (a == "--grow") growSpec = next();
-        else if (a.rfind("--", 0) == 0) usage(2);
-        else files.push_back(a);
-    }
-    if (files.empty() == growSpec.empty()) usage(2);
+    CLI::App app{"kiln-bench-scene — for each glTF file: load (parse, check, flatten), first frame (scene load,\n"
+                 "upload and the default pipeline's first frame) and save->pixels (a material's colour saved until\n"
+                 "the centre pixel changes); --grow: the frame with a generated model of more and more triangles\n"
+                 "or lights. A few seconds a file at 256x256 with 10 trials. Writes OUT/scene.csv or OUT/grow_*.csv.",
+                 "kiln-bench-scene"};
+    cli::configure(app);
+    cli::addSize(app, "--size", width, height, 16, 16384, "the picture's size (default 256x256)");
+    app.add_option("--trials", trials, "trials per file, the median kept (default 10)")->type_name("N")->check(CLI::Range(2, 1 << 20));
+    app.add_option("--out", outDir, "where the CSV goes (default bench-out)")->type_name("DIR");
+    app.add_option("--grow", growSpec, "a generated model instead of files")->type_name("triangles|lights=N1,N2");
+    app.add_option("files", files, "glTF files (.gltf, .glb)")->type_name("FILE");
+    if (const std::optional<int> exitNow = cli::parse(app, argc, argv)) return *exitNow;
+    if (files.empty() == growSpec.empty()) return cli::usageError(app, "give glTF files or --grow, not both and not neither");
     std::string error;
     auto context = app::HeadlessContext::create(false, error);
     if (!context) {

@@ -9,8 +9,6 @@
 // Prints a table, writes JSON (--out DIR, soak.json) and exits 1 if anything grew beyond
 // its tolerance after warm-up (RSS: --rss-tolerance-mb, default 16; textures, fds,
 // threads: none), any GL error was counted, or any texture held a NaN/Inf.
-//   kiln-soak [--frames N=10000] [--size WxH=64x64] [--scan-every N=500] [--out DIR=bench-out]
-//             [--edit-rounds N=3] [--rss-tolerance-mb MB=16] [--trace (RSS at every scan)]
 #include <unistd.h>
 
 #include <chrono>
@@ -28,6 +26,7 @@
 #include "app/app.hpp"
 #include "app/context.hpp"
 #include "app/editable_copy.hpp"
+#include "command_line/command_line.hpp"
 #include "kiln/gl.hpp"
 #include "kiln/image_io.hpp"
 #include "kiln/log.hpp"
@@ -130,25 +129,23 @@ struct Options {
     std::string outDir = "bench-out";
 };
 
-std::optional<Options> parseOptions(int argc, char** argv) {
+std::optional<Options> parseOptions(int argc, char** argv, int& exitStatus) {
     Options o;
-    for (int i = 1; i < argc; ++i) {
-        const std::string a = argv[i];
-        const bool hasValue = i + 1 < argc;
-        if (a == "--frames" && hasValue) o.frames = std::atoi(argv[++i]);
-        else if (a == "--size" && hasValue && std::sscanf(argv[++i], "%dx%d", &o.width, &o.height) == 2) {}
-        else if (a == "--scan-every" && hasValue) o.scanEvery = std::atoi(argv[++i]);
-        else if (a == "--rss-tolerance-mb" && hasValue) o.rssToleranceMb = std::atof(argv[++i]);
-        else if (a == "--out" && hasValue) o.outDir = argv[++i];
-        else if (a == "--edit-rounds" && hasValue) o.rounds = std::atoi(argv[++i]);
-        else if (a == "--trace") o.trace = true;
-        else {
-            std::fprintf(stderr, "kiln-soak: error: unknown or incomplete option \"%s\"\n", a.c_str());
-            return std::nullopt;
-        }
-    }
-    if (o.frames < 300 || o.width < 8 || o.height < 8 || o.width > 4096 || o.height > 4096 || o.scanEvery < 1) {
-        std::fprintf(stderr, "kiln-soak: error: --frames ≥ 300 (100 of warm-up, then a stretch before and after the edits), --size from 8x8 to 4096x4096, --scan-every ≥ 1\n");
+    CLI::App app{"kiln-soak — a long headless run of the default scene with a burst of live edits in the middle,\n"
+                 "watching RSS, texture bytes, file descriptors, threads, GL errors and NaN/Inf in every texture;\n"
+                 "exits 1 if anything grew or went bad. Writes OUT/soak.json.",
+                 "kiln-soak"};
+    cli::configure(app);
+    app.add_option("--frames", o.frames, "frames in all, at least 300 (default 10000)")->type_name("N")->check(CLI::Range(300, 100'000'000));
+    cli::addSize(app, "--size", o.width, o.height, 8, 4096, "the picture's size (default 64x64)");
+    app.add_option("--scan-every", o.scanEvery, "frames between NaN/Inf scans of every texture (default 500)")
+        ->type_name("N")->check(CLI::Range(1, 100'000'000));
+    app.add_option("--rss-tolerance-mb", o.rssToleranceMb, "RSS growth allowed after warm-up (default 16)")->type_name("MB")->check(CLI::Range(0.0, 1e6));
+    app.add_option("--edit-rounds", o.rounds, "rounds of the edit burst (default 3)")->type_name("N")->check(CLI::Range(0, 10000));
+    app.add_flag("--trace", o.trace, "record RSS at every scan");
+    app.add_option("--out", o.outDir, "where soak.json goes (default bench-out)")->type_name("DIR");
+    if (const std::optional<int> exitNow = cli::parse(app, argc, argv)) {
+        exitStatus = *exitNow;
         return std::nullopt;
     }
     return o;
@@ -331,8 +328,9 @@ private:
 }  // namespace
 
 int main(int argc, char** argv) {
-    const std::optional<Options> options = parseOptions(argc, argv);
-    if (!options) return 2;
+    int exitStatus = 0;
+    const std::optional<Options> options = parseOptions(argc, argv, exitStatus);
+    if (!options) return exitStatus;
     std::string error;
     auto context = app::HeadlessContext::create(/*debug=*/true, error);
     if (!context) {

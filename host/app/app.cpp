@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "kiln/data_root.hpp"
 #include "kiln/log.hpp"
 #include "scene/punctual.hpp"
 #include "scene/redraw_region.hpp"
@@ -54,6 +55,7 @@ bool App::init(const Options& o, std::string& error) {
     // that has a file wins.
     for (const std::string& dir : pathList(o.shaderRoot)) ro.shaderRoots.emplace_back(dir);
     for (const std::string& dir : pathList(o.moduleDir)) ro.moduleDirs.emplace_back(dir);
+    ro.pipelineSearchDirs = {(shippedFiles().data / "pipelines").string()};
     ro.width = o.width;
     ro.height = o.height;
     if (!runtime_.init(ro, error)) return false;
@@ -74,10 +76,25 @@ bool App::init(const Options& o, std::string& error) {
     }
     requested_ = requestedTextures();
     runtime_.setRequested(requested_);
+    std::vector<Runtime::ParamOverride> overrides;
+    for (const std::string& set : o.sets) {  // PASS.PARAM=VALUE, checked when parsed
+        const size_t dot = set.find('.'), eq = set.find('=');
+        overrides.push_back({set, set.substr(0, dot), set.substr(dot + 1, eq - dot - 1), set.substr(eq + 1)});
+    }
+    runtime_.setOverrides(std::move(overrides));
     std::string errors;
     if (!runtime_.loadPipeline(o.pipeline, errors)) {
         if (!errors.empty() && errors.back() == '\n') errors.pop_back();
         error = errors;
+        return false;
+    }
+    // A --view the pipeline has no texture for is an error, not a warning and the graph's
+    // output instead.
+    if (const auto& shown = runtime_.plan()->requested; !o.view.empty() && std::find(shown.begin(), shown.end(), o.view) == shown.end()) {
+        error = "--view " + o.view + ": not a texture of the running pipeline";
+        const std::string named = "viewed texture \"" + o.view + "\": ";
+        for (const auto& w : runtime_.plan()->warnings)
+            if (w.message.rfind(named, 0) == 0) error = "--view " + o.view + ": " + w.message.substr(named.size());
         return false;
     }
     if (o.live) live_.start(*this);

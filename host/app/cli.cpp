@@ -1,56 +1,17 @@
 #include "app/cli.hpp"
 
 #include <algorithm>
-#include <charconv>
-#include <cstring>
+#include <cctype>
 #include <filesystem>
-#include <string_view>
 
+#include "command_line/command_line.hpp"
 #include "kiln/data_root.hpp"
 
 namespace kiln::app {
 
-const char* kUsage = R"(kiln — a render-pass framework with hot reload
+namespace {
 
-usage: kiln [options]
-
-  --pipeline FILE   pipeline graph (default pipelines/default.json, see below)
-  --scene FILE      scene description (default scenes/cornell.json, see below)
-  --headless        render with EGL, no window
-  --size WxH        output size (default 720x720)
-  --frames N        frames to render in headless mode (default 1)
-  --out FILE.png    write the final image (headless)
-  --watch           headless: keep running after --frames frames, rewrite --out
-                    (and --dump) after every frame in which a live edit landed,
-                    until interrupted (SIGINT/SIGTERM); a preview for an image viewer
-  --dump DIR        headless: write every texture of the last frame (PNG, and OpenEXR for
-                    float/depth); window: where the texture window's "save" writes
-                    (default ./kiln-saves)
-  --stats           print the per-pass time table (GPU timer queries + CPU clock)
-  --no-live         do not watch files for live reloading
-  --no-skip         run every pass every frame, even when nothing it reads changed
-  --full-redraw     redraw the whole picture when only bodies moved (not their footprints)
-  --plan            print the compiled plan (order, culled passes and why)
-  --dot FILE        write the plan as graphviz dot
-  --view PASS.OUT   show this texture instead of the graph output (un-culls its producer)
-  --screenshot F    window mode: save the window (debug view included) after
-                    --frames frames, then quit
-  --budget MS       window: lower the render resolution while frames take
-                    longer than MS (default 100; 0 keeps full resolution)
-  --ui-probe FILE   window mode: keep FILE (JSON) up to date with where each
-                    debug-view widget is on screen and what the texture readout
-                    says, so scripts (xdotool) can drive the window
-  --watchdog S      a pass's execute() (or a module's load) running longer than
-                    S seconds is interrupted and named (default 10; 0: never)
-  --seed N          simulation seed (same seed, same frames)
-  --paused          do not advance the simulation
-  --shaders DIRS    shader roots, ':'-separated, the first that has a file wins,
-                    all watched; an empty entry is the shipped shaders/ (see
-                    below): "--shaders mine:" searches mine/, then them
-  --modules DIRS    pass module directories, the same way ("--modules mine:")
-  --help            this text
-
-Window keys and mouse:
+constexpr const char* kWindowKeys = R"(Window keys and mouse:
   drag a tumbler below its centre   move it on the floor
   drag a tumbler above its centre   tilt it (it rolls the matching distance)
   drag empty space                  orbit the camera          wheel  zoom
@@ -62,11 +23,6 @@ Window keys and mouse:
   compare view: drag the line across the image
 )";
 
-namespace {
-bool parseInt(std::string_view s, long long& out) {
-    auto r = std::from_chars(s.data(), s.data() + s.size(), out);
-    return r.ec == std::errc() && r.ptr == s.data() + s.size();
-}
 }  // namespace
 
 std::filesystem::path defaultDataRoot() {
@@ -106,112 +62,107 @@ void applyDefaults(Options& o) {
     o.moduleDir = withShipped(o.moduleDir, shippedFiles().modules.string());
 }
 
-std::string usage() {
-    return std::string(kUsage) + "\nDefault pipeline, scene and shaders come from " + defaultDataRoot().string() +
-           "\n  (the working directory when it has pipelines/default.json and shaders/, else " +
-           shippedFiles().describe() + ")\n";
-}
-
 namespace {
 
-// Switches: each sets one field.
-struct Switch {
-    std::string_view name;
-    bool Options::*field;
-    bool value;
-};
-constexpr Switch kSwitches[] = {{"--help", &Options::help, true},        {"-h", &Options::help, true},
-                                {"--headless", &Options::headless, true}, {"--stats", &Options::stats, true},
-                                {"--no-live", &Options::live, false},     {"--no-skip", &Options::noSkip, true},
-                                {"--plan", &Options::printPlan, true},    {"--paused", &Options::paused, true},
-                                {"--watch", &Options::watch, true},       {"--full-redraw", &Options::fullRedraw, true}};
-
-// Options whose value is kept as text (paths, a texture name).
-struct TextOption {
-    std::string_view name;
-    std::string Options::*field;
-};
-constexpr TextOption kTextOptions[] = {
-    {"--pipeline", &Options::pipeline}, {"--scene", &Options::scene},     {"--out", &Options::out},
-    {"--dump", &Options::dump},         {"--dot", &Options::dot},         {"--shaders", &Options::shaderRoot},
-    {"--modules", &Options::moduleDir}, {"--view", &Options::view},       {"--screenshot", &Options::screenshot},
-    {"--ui-probe", &Options::uiProbe}};
-
-bool parseSize(const std::string& v, Options& o, std::string& error) {
-    const auto x = v.find('x');
-    long long w = 0, h = 0;
-    if (x == std::string::npos || !parseInt(std::string_view(v).substr(0, x), w) ||
-        !parseInt(std::string_view(v).substr(x + 1), h) || w < 1 || h < 1 || w > 16384 || h > 16384) {
-        error = "--size " + v + ": expected WxH with 1 <= W, H <= 16384 (e.g. 720x720)";
-        return false;
-    }
-    o.width = static_cast<int>(w);
-    o.height = static_cast<int>(h);
-    return true;
+bool hasExtension(const std::string& file, std::initializer_list<const char*> extensions) {
+    std::string ext = std::filesystem::path(file).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    return std::any_of(extensions.begin(), extensions.end(), [&](const char* e) { return ext == e; });
 }
 
-// --budget, --watchdog, --frames, --seed: whole numbers, bounded where the value lands
-// (frames in an int, the seed in 63 bits: parseInt's range), so nothing wraps.
-bool parseNumber(std::string_view a, const std::string& v, Options& o, std::string& error) {
-    constexpr long long kMaxFrames = 1'000'000'000;
-    long long n = 0;
-    const bool parsed = parseInt(v, n);
-    if (a == "--budget" || a == "--watchdog") {
-        const bool budget = a == "--budget";
-        const long long most = budget ? 100000 : 86400;
-        if (!parsed || n < 0 || n > most) {
-            error = std::string(a) + " " + v + ": expected " + (budget ? "milliseconds" : "whole seconds") + ", 0 to " +
-                    std::to_string(most) + (budget ? " (0: off)" : " (0: never)");
-            return false;
-        }
-        (budget ? o.budgetMs : o.watchdogSeconds) = static_cast<int>(n);
-    } else if (a == "--frames") {
-        if (!parsed || n < 1 || n > kMaxFrames) {
-            error = std::string(a) + " " + v + ": expected a whole number of frames from 1 to " + std::to_string(kMaxFrames);
-            return false;
-        }
-        o.frames = static_cast<int>(n);
-    } else {
-        if (!parsed || n < 0) {
-            error = std::string(a) + " " + v + ": expected a non-negative integer";
-            return false;
-        }
-        o.seed = static_cast<uint64_t>(n);
+// The checks CLI11 cannot make: what a mode needs and which options it has no use for.
+// Each returns "" or the one line that explains the refusal.
+std::string checkCombination(const CLI::App& app, const Options& o) {
+    auto given = [&](const char* name) { return app.count(name) > 0; };
+    if (o.listModules || !o.describe.empty()) return "";
+    for (const std::string& set : o.sets) {
+        const size_t dot = set.find('.'), eq = set.find('=');
+        if (dot == std::string::npos || eq == std::string::npos || dot > eq || dot == 0 || eq == dot + 1)
+            return "--set " + set + ": expected PASS.PARAM=VALUE (e.g. --set shadow.size=1024)";
     }
-    return true;
+    if (!o.out.empty() && !hasExtension(o.out, {".png", ".exr", ".pfm"}))
+        return "--out " + o.out + ": the format follows the extension: .png (8 bits, display), .exr or .pfm (float)";
+    if (o.watch && (!o.headless || !o.live || (o.out.empty() && o.dump.empty())))
+        return "--watch keeps a headless run going and rewrites its files after each live edit: it needs --headless "
+               "and --out or --dump, and not --no-live";
+    if (o.headless) {
+        for (const char* windowOnly : {"--screenshot", "--ui-probe", "--budget"})
+            if (given(windowOnly))
+                return std::string(windowOnly) + " is for the window; a headless run writes --out, --dump or --stats";
+        if (o.out.empty() && o.dump.empty() && !o.stats && !o.printPlan && o.dot.empty())
+            return "a headless run needs something to write: --out FILE, --dump DIR, --stats, --plan or --dot FILE";
+    } else {
+        for (const char* headlessOnly : {"--out", "--stats"})
+            if (given(headlessOnly))
+                return std::string(headlessOnly) + " is for --headless; the window saves with --screenshot FILE";
+        if (!o.screenshot.empty() && !hasExtension(o.screenshot, {".png"}))
+            return "--screenshot " + o.screenshot + ": a screenshot is a .png";
+    }
+    return "";
 }
 
 }  // namespace
 
-std::optional<Options> parseOptions(int argc, char** argv, std::string& error) {
+std::variant<Options, int> parseCommandLine(int argc, char** argv) {
     Options o;
-    for (int i = 1; i < argc; ++i) {
-        const std::string_view a = argv[i];
-        const Switch* flag = std::find_if(std::begin(kSwitches), std::end(kSwitches), [&](auto& f) { return f.name == a; });
-        if (flag != std::end(kSwitches)) {
-            o.*(flag->field) = flag->value;
-            continue;
-        }
-        const TextOption* text =
-            std::find_if(std::begin(kTextOptions), std::end(kTextOptions), [&](auto& t) { return t.name == a; });
-        const bool number = a == "--budget" || a == "--watchdog" || a == "--frames" || a == "--seed";
-        if (text == std::end(kTextOptions) && !number && a != "--size") {
-            error = "unknown argument \"" + std::string(a) + "\" (see kiln --help)";
-            return std::nullopt;
-        }
-        if (i + 1 >= argc) {
-            error = std::string(a) + " needs a value";
-            return std::nullopt;
-        }
-        const std::string v = argv[++i];
-        if (text != std::end(kTextOptions)) o.*(text->field) = v;
-        else if (a == "--size" ? !parseSize(v, o, error) : !parseNumber(a, v, o, error)) return std::nullopt;
-    }
-    if (o.watch && (!o.headless || !o.live || (o.out.empty() && o.dump.empty()))) {
-        error = "--watch keeps a headless run going and rewrites its files after each live edit: it needs --headless "
-                "and --out or --dump, and not --no-live";
-        return std::nullopt;
-    }
+    CLI::App app{"kiln — a render-pass framework with hot reload (OpenGL 4.5)", "kiln"};
+    cli::configure(app);
+    const char* input = "Input";
+    app.add_option("--pipeline", o.pipeline, "the pipeline graph (default pipelines/default.json)")->type_name("FILE")->group(input);
+    app.add_option("--scene", o.scene, "a scene JSON or a glTF 2.0 file (default scenes/cornell.json)")
+        ->type_name("FILE")->group(input);
+    app.add_option("--set", o.sets, "set a parameter over the file's value (repeatable; kept over reloads)")
+        ->type_name("PASS.PARAM=VALUE")->allow_extra_args(false)->group(input);
+    app.add_option("--shaders", o.shaderRoot, "shader roots, ':'-separated, first wins; an empty entry is the shipped ones")
+        ->type_name("DIRS")->group(input);
+    app.add_option("--modules", o.moduleDir, "pass module directories, the same way (\"--modules mine:\")")->type_name("DIRS")->group(input);
+    long long seed = -1;
+    app.add_option("--seed", seed, "simulation seed: the same seed, the same frames (default: the scene's)")
+        ->type_name("N")->check(CLI::NonNegativeNumber.description(""))->group(input);
+
+    const char* run = "Running";
+    app.add_flag("--headless", o.headless, "render with EGL, no window")->group(run);
+    cli::addSize(app, "--size", o.width, o.height, 1, 16384, "the picture's size (default 720x720)")->group(run);
+    app.add_option("--frames", o.frames, "frames before the outputs (default 1); then up to 64 settling frames")
+        ->type_name("N")->check(CLI::Range(1, 1'000'000'000))->group(run);
+    app.add_flag("--paused", o.paused, "do not advance the simulation")->group(run);
+    app.add_flag_callback("--no-live", [&o] { o.live = false; }, "do not watch files for live reloading")->group(run);
+    app.add_flag("--no-skip", o.noSkip, "run every pass every frame, changed or not (timing)")->group(run);
+    app.add_flag("--full-redraw", o.fullRedraw, "redraw all of the picture when only bodies moved")->group(run);
+    app.add_option("--view", o.view, "show (and --out) this texture, not the graph's output")
+        ->type_name("PASS.OUTPUT")->group(run);
+    app.add_option("--watchdog", o.watchdogSeconds, "interrupt a pass's call after S seconds (default 10; 0: never)")
+        ->type_name("S")->check(CLI::Range(0, 86400))->group(run);
+
+    const char* headless = "Headless output";
+    app.add_option("--out", o.out, "write the final image: .png, .exr or .pfm")->type_name("FILE")->group(headless);
+    app.add_option("--dump", o.dump, "write every texture (PNG; EXR for float); window: where \"save\" writes")
+        ->type_name("DIR")->group(headless);
+    app.add_flag("--stats", o.stats, "print the time of each pass (GPU timer queries and CPU)")->group(headless);
+    app.add_flag("--plan", o.printPlan, "print the compiled plan: order, culled passes and why")->group(headless);
+    app.add_option("--dot", o.dot, "write the plan as graphviz dot")->type_name("FILE")->group(headless);
+    app.add_flag("--watch", o.watch, "rewrite --out and --dump after each live edit, until Ctrl+C")->group(headless);
+
+    const char* window = "Window";
+    app.add_option("--screenshot", o.screenshot, "save the window after --frames frames, then quit")
+        ->type_name("FILE.png")->group(window);
+    app.add_option("--budget", o.budgetMs, "lower the resolution while frames take > MS (default 100; 0: off)")
+        ->type_name("MS")->check(CLI::Range(0, 100000))->group(window);
+    app.add_option("--ui-probe", o.uiProbe, "keep FILE (JSON) saying where each widget is, for scripts")
+        ->type_name("FILE")->group(window);
+
+    const char* discover = "Discover (print and exit)";
+    app.add_flag("--list-modules", o.listModules, "list the pass modules --modules finds")->group(discover);
+    app.add_option("--describe", o.describe, "a module's inputs, outputs, parameters (Markdown; \"all\")")
+        ->type_name("MODULE")->group(discover);
+
+    app.footer(std::string(kWindowKeys) + "\nExit status: 0 done, 1 the run failed, 2 a usage error, 130 interrupted.\n" +
+               "Default pipeline, scene and shaders come from " + defaultDataRoot().string() +
+               "\n  (the working directory when it has pipelines/default.json and shaders/, else " +
+               shippedFiles().describe() + ")\n");
+    if (std::optional<int> exitNow = cli::parse(app, argc, argv)) return *exitNow;
+    if (seed >= 0) o.seed = uint64_t(seed);
+    if (const std::string wrong = checkCombination(app, o); !wrong.empty()) return cli::usageError(app, wrong);
     return o;
 }
 

@@ -3,8 +3,9 @@
 
 #include <cstdint>
 #include <filesystem>
-#include <optional>
 #include <string>
+#include <variant>
+#include <vector>
 
 namespace kiln::app {
 
@@ -17,8 +18,8 @@ struct Options {
     std::string moduleDir;    // ':'-separated; an empty entry: the shipped modules
     bool headless = false;
     int width = 720, height = 720;
-    int frames = 1;
-    std::string out;          // PNG of the final image
+    int frames = 1;           // frames rendered before the outputs (then the GI settles)
+    std::string out;          // the final image: PNG, OpenEXR or PFM by its extension
     std::string dump;         // directory for every texture of the last frame
     bool stats = false;
     bool noSkip = false;      // run every pass every frame (for timing tables)
@@ -29,7 +30,9 @@ struct Options {
     bool live = true;         // watch files and reload them while running
     bool watch = false;       // headless: run until interrupted, rewrite the outputs after each reload
     bool paused = false;      // freeze the simulation (time stays at 0 + frames×0)
-    bool help = false;
+    std::vector<std::string> sets;  // --set PASS.PARAM=VALUE, in command-line order
+    bool listModules = false;  // print the modules found and exit
+    std::string describe;      // print a module's declaration ("all": every module) and exit
     std::string screenshot;   // window: save the window after --frames frames and quit
     std::string view;         // "pass.output" to show instead of the graph output
     int budgetMs = 100;       // window: frame-time budget for the render resolution (0: off)
@@ -37,10 +40,10 @@ struct Options {
     std::string uiProbe;      // window: JSON file of widget rectangles and readouts
 };
 
-extern const char* kUsage;
-
-// Parses argv; on a bad argument returns nullopt and sets `error` to one line.
-std::optional<Options> parseOptions(int argc, char** argv, std::string& error);
+// Parses argv (the conventions of command_line/command_line.hpp). Returns the options to
+// run with, or the exit status when kiln must stop now: 0 after --help or --version, 2
+// after a usage error (one line on stderr).
+std::variant<Options, int> parseCommandLine(int argc, char** argv);
 // Where unset paths point: the working directory when it holds a Kiln tree
 // (pipelines/default.json and shaders/), else the shipped files (kiln/data_root.hpp:
 // the installation's, or the source tree's for a build-tree kiln).
@@ -49,7 +52,5 @@ std::filesystem::path defaultDataRoot();
 // defaultDataRoot(); its shaders/ and the shipped modules where the lists are empty or
 // have an empty entry.
 void applyDefaults(Options&);
-// kUsage and where the defaults come from on this machine.
-std::string usage();
 
 }  // namespace kiln::app

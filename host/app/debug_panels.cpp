@@ -38,6 +38,11 @@ void PipelineEditor::setParam(App& app, const std::string& pass, const std::stri
 void PipelineEditor::writeBack(App& app) {
     Runtime& rt = app.runtime();
     if (!rt.pipelineDesc()) return;
+    if (rt.pipelineChain().size() > 1) {  // its passes are partly another file's
+        error = rt.pipelineFile() + ": not written back: it extends " + rt.pipelineChain()[1].string() +
+                "; set the value in it by hand";
+        return;
+    }
     std::string why;
     std::optional<std::string> text = graph::patchPipelineText(rt.pipelineText(), *rt.pipelineDesc(), why);
     if (!text) {

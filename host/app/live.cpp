@@ -32,16 +32,25 @@ void LiveReload::start(App& app) {
     for (auto& root : app.runtime().shaders().roots()) watcher_->watch(root);
     for (auto& dir : app.runtime().loader().dirs()) watcher_->watch(dir);
     // Pipelines and scenes are JSON files; their directories may hold anything.
-    watcher_->watch(canonical(app.runtime().pipelineFile()).parent_path(), FileWatcher::Depth::ThisDirectory, ".json");
+    watchPipelineChain(app);
     watcher_->watch(canonical(app.scene().file()).parent_path(), FileWatcher::Depth::ThisDirectory, ".json");
     watchModels(app);
+}
+
+// The files the pipeline extends, wherever they are: a save to one reloads the pipeline.
+void LiveReload::watchPipelineChain(App& app) {
+    std::vector<fs::path> files = app.runtime().pipelineChain();
+    files.push_back(app.runtime().pipelineFile());
+    for (const fs::path& file : files)
+        if (const fs::path dir = (canonical)(file).parent_path(); pipelineDirs_.insert(dir).second)
+            watcher_->watch(dir, FileWatcher::Depth::ThisDirectory, ".json");
 }
 
 // The placed models' files (glTF, buffers, images): every file of their directories is
 // watched, the ones the models were read from reload them.
 void LiveReload::watchModels(App& app) {
     for (const std::string& file : app.scene().modelFiles()) {
-        const fs::path dir = canonical(file).parent_path();
+        const fs::path dir = (canonical)(file).parent_path();
         if (std::find(modelDirs_.begin(), modelDirs_.end(), dir) != modelDirs_.end()) continue;
         modelDirs_.push_back(dir);
         watcher_->watch(dir, FileWatcher::Depth::ThisDirectory);
@@ -146,9 +155,12 @@ int LiveReload::poll(App& app) {
     for (auto& path : changed) {
         const auto t0 = std::chrono::steady_clock::now();
         const std::string name = path.filename().string();
-        if (path == pipeline) {
+        const auto& chain = rt.pipelineChain();
+        const bool inChain = std::any_of(chain.begin(), chain.end(), [&](const fs::path& f) { return (canonical)(f) == path; });
+        if (path == pipeline || inChain) {
             std::string errors;
-            if (rt.loadPipeline(path, errors)) {
+            if (rt.loadPipeline(pipeline, errors)) {
+                watchPipelineChain(app);  // the chain may have grown
                 rt.setExternalError("pipeline", "");
                 log::info("reloaded pipeline ", path.string(), " in ", msSince(t0), " ms");
                 ++pipelineReloads, ++reloads;

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -48,6 +49,8 @@ private:
     };
     void reloadModule(App& app, const std::string& module, const std::filesystem::path& path);
     void watchModels(App& app);
+    void watchPipelineChain(App& app);
+    std::set<std::filesystem::path> pipelineDirs_;  // watched for the pipeline and the files it extends
     bool isModelFile(App& app, const std::filesystem::path& path) const;
     std::vector<std::filesystem::path> modelDirs_;  // watched for the placed models' files
     int retryModules(App& app);

@@ -11,7 +11,9 @@
 #include "app/app.hpp"
 #include "app/cli.hpp"
 #include "app/context.hpp"
+#include "app/describe.hpp"
 #include "app/stop_signal.hpp"
+#include "command_line/command_line.hpp"
 #include "kiln/guard.hpp"
 #include "kiln/image_io.hpp"
 #include "kiln/log.hpp"
@@ -24,7 +26,33 @@ namespace {
 
 int fail(const std::string& message) {
     log::error(message);  // every line prefixed
-    return 1;
+    return cli::kExitFailure;
+}
+
+// The final image in the format its extension names (checked when parsing).
+bool writeImage(const std::string& file, const FloatImage& img, std::string& error) {
+    std::string ext = fs::path(file).extension().string();
+    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+    if (ext == ".exr") return writeExr(file, img, error);
+    if (ext == ".pfm") return writePfm(file, img, error);
+    return writePng(file, img, 3, error);
+}
+
+// Where the outputs go exists before anything renders: a run that cannot write its
+// result fails in its first second, not after its last frame.
+bool prepareOutputs(const Options& o, std::string& error) {
+    auto ensureDirectory = [&](const fs::path& dir, const std::string& what) {
+        if (dir.empty()) return true;
+        std::error_code ec;
+        fs::create_directories(dir, ec);
+        if (fs::is_directory(dir)) return true;
+        error = what + ": cannot create the directory " + dir.string() + (ec ? " (" + ec.message() + ")" : "");
+        return false;
+    };
+    return ensureDirectory(fs::path(o.out).parent_path(), "--out " + o.out) &&
+           ensureDirectory(fs::path(o.dot).parent_path(), "--dot " + o.dot) &&
+           ensureDirectory(fs::path(o.screenshot).parent_path(), "--screenshot " + o.screenshot) &&
+           ensureDirectory(o.dump.empty() || !o.headless ? fs::path() : fs::path(o.dump), "--dump " + o.dump);
 }
 
 // --out and --dump from the frame just rendered.
@@ -37,7 +65,7 @@ bool writeOutputs(App& app, const Options& o, std::string& error) {
             return false;
         }
         FloatImage img = readTexture(out->id, out->target, out->format, out->width, out->height);
-        if (!writePng(o.out, img, 3, error)) return false;
+        if (!writeImage(o.out, img, error)) return false;
         log::info("wrote ", o.out, " (", img.width, "x", img.height, ")");
     }
     if (!o.dump.empty()) {
@@ -66,7 +94,7 @@ int watch(App& app, const Options& o) {
         std::this_thread::sleep_until(next);
     }
     log::info("stopped watching");
-    return 0;
+    return exitStatusAfterStop();
 }
 
 int runHeadless(const Options& o) {
@@ -78,7 +106,9 @@ int runHeadless(const Options& o) {
     if (!app.init(o, error)) return fail(error);
 
     app.runtime().alwaysRun = o.noSkip;
-    for (int f = 0; f < o.frames; ++f) app.frame();
+    catchStopSignals();
+    for (int f = 0; f < o.frames && !stopSignalled; ++f) app.frame();
+    if (stopSignalled) return exitStatusAfterStop();
     // The outputs show the last frame's moment converged, not part way (voxel bounces
     // fed back gain one a frame).
     if (const int settled = app.settle()) log::info("settled in ", settled, settled == 1 ? " frame" : " frames");
@@ -95,15 +125,13 @@ int runHeadless(const Options& o) {
 }  // namespace
 
 int main(int argc, char** argv) {
-    std::string error;
-    auto parsed = parseOptions(argc, argv, error);
-    if (!parsed) return fail(error);
-    Options o = *parsed;
-    if (o.help) {
-        std::printf("%s", usage().c_str());
-        return 0;
-    }
+    auto parsed = parseCommandLine(argc, argv);
+    if (const int* exitNow = std::get_if<int>(&parsed)) return *exitNow;
+    Options o = std::get<Options>(parsed);
     applyDefaults(o);
+    if (o.listModules) return listModules(o);
+    if (!o.describe.empty()) return describeModules(o, o.describe);
+    if (std::string error; !prepareOutputs(o, error)) return fail(error);
     guard::setWatchdogLimit(std::chrono::seconds(o.watchdogSeconds));
     if (o.headless) return runHeadless(o);
     return runWindow(o);

@@ -250,7 +250,7 @@ int runWindow(const Options& o) {
     ImGui_ImplOpenGL3_Shutdown();
     ImGui_ImplGlfw_Shutdown();
     ImGui::DestroyContext();
-    return 0;
+    return stopSignalled ? exitStatusAfterStop() : 0;
 }
 
 }  // namespace kiln::app

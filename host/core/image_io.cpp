@@ -5,6 +5,7 @@
 #include <tinyexr.h>
 
 #include <algorithm>
+#include <bit>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -86,6 +87,26 @@ bool writeExr(const std::string& path, const FloatImage& img, std::string& error
         return false;
     }
     return true;
+}
+
+bool writePfm(const std::string& path, const FloatImage& img, std::string& error) {
+    std::FILE* f = std::fopen(path.c_str(), "wb");
+    if (!f) {
+        error = path + ": cannot write PFM: " + std::strerror(errno);
+        return false;
+    }
+    static_assert(std::endian::native == std::endian::little, "the scale's sign below says little-endian");
+    std::fprintf(f, "PF\n%d %d\n-1.0\n", img.width, img.height);  // a negative scale: little-endian
+    std::vector<float> row(static_cast<size_t>(img.width) * 3);
+    bool ok = true;
+    for (int y = 0; y < img.height && ok; ++y) {
+        for (int x = 0; x < img.width; ++x)
+            for (int c = 0; c < 3; ++c) row[static_cast<size_t>(x) * 3 + c] = c < img.channels ? img.at(x, y)[c] : 0.0f;
+        ok = std::fwrite(row.data(), sizeof(float), row.size(), f) == row.size();
+    }
+    ok = std::fclose(f) == 0 && ok;
+    if (!ok) error = path + ": cannot write PFM: " + std::strerror(errno);
+    return ok;
 }
 
 bool readExr(const std::string& path, FloatImage& out, std::string& error) {

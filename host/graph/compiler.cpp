@@ -238,6 +238,15 @@ private:
         d.severity = s;
         d.file = desc_.fileName;
         d.path = path;
+        // A pass of an extending pipeline is reported where its entry was written.
+        if (key >= 0 && size_t(key) < desc_.passes.size()) {
+            const PassDesc::Origin& origin = desc_.passes[size_t(key)].origin;
+            const std::string merged = passPath(key);
+            if (!origin.file.empty() && path.rfind(merged, 0) == 0) {
+                d.file = origin.file;
+                d.path = passPath(origin.index) + path.substr(merged.size());
+            }
+        }
         d.message = std::move(message);
         diags_.emplace_back(key, std::move(d));
     }
@@ -748,6 +757,10 @@ std::optional<ParamValue> checkParamValue(const ParamValue& v, const ParamDecl& 
     return Compiler::checkValue(ParamLiteral::of(v), d, problem);
 }
 
+std::optional<ParamValue> checkParamLiteral(const ParamLiteral& l, const ParamDecl& d, std::string& problem) {
+    return Compiler::checkValue(l, d, problem);
+}
+
 Result<Plan> compile(const PipelineDesc& desc, const CompileOptions& options) {
     return Compiler(desc, options).run();
 }
@@ -755,7 +768,12 @@ Result<Plan> compile(const PipelineDesc& desc, const CompileOptions& options) {
 Result<Plan> compileText(const std::string& text, const std::string& fileName, const CompileOptions& options) {
     Result<PipelineDesc> desc = parsePipeline(text, fileName);
     if (!desc) return Result<Plan>(desc.errors());
-    return compile(*desc, options);
+    const PipelineReader read = [](const std::string& file, std::string& out, std::string& why) {
+        return json_text::readBoundedFile(file, kMaxPipelineFileBytes, "pipeline file", out, why);
+    };
+    Result<PipelineDesc> resolved = resolveExtends(std::move(*desc), read, nullptr, options.pipelineSearchDirs);
+    if (!resolved) return Result<Plan>(resolved.errors());
+    return compile(*resolved, options);
 }
 
 }  // namespace kiln::graph

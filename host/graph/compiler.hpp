@@ -60,6 +60,8 @@ struct CompileOptions {
     // "pass.output" (or "pass.internal") strings the debug view shows or --dump wants;
     // they un-cull their producers. Ones that don't exist become Plan::warnings.
     std::vector<std::string> requested;
+    // compileText only: where a relative "extends" is looked for after beside the file.
+    std::vector<std::string> pipelineSearchDirs;
 };
 
 // On success, the Plan (with Plan::warnings). On failure, errors() holds every error
@@ -68,8 +70,10 @@ Result<Plan> compile(const PipelineDesc&, const CompileOptions&);
 // Checks a value against its declaration as compile() does a file's (type, range,
 // choices); the value as the parameter holds it, or nullopt and `problem` says why.
 std::optional<ParamValue> checkParamValue(const ParamValue&, const ParamDecl&, std::string& problem);
+std::optional<ParamValue> checkParamLiteral(const ParamLiteral&, const ParamDecl&, std::string& problem);
 
-// parsePipeline + compile.
+// parsePipeline + resolveExtends (the files it extends read from disk, relative to
+// `fileName`, then in CompileOptions::pipelineSearchDirs) + compile.
 Result<Plan> compileText(const std::string& text, const std::string& fileName, const CompileOptions&);
 
 }  // namespace kiln::graph

@@ -94,7 +94,14 @@ ParamLiteral toLiteral(const Json& j) {
     return l;
 }
 
+}  // namespace
 
+ParamLiteral parseParamLiteral(const std::string& value) {
+    const Json j = Json::parse(value, nullptr, /*allow_exceptions=*/false);
+    return toLiteral(j.is_discarded() ? Json(value) : j);
+}
+
+namespace {
 
 class Reader {
 public:
@@ -118,11 +125,13 @@ public:
         error(keyPath(path, key), "unknown key \"" + key + "\"" + suggestion(key, known, "keys"));
     }
 
-    void readPass(const Json& j, const std::string& path, PassDesc& pass) {
-        static const std::vector<std::string> kKeys = {"id", "module", "enabled", "params", "inputs", "note"};
+    // Whether the entry names its module (only an extending file may leave it out).
+    bool readPass(const Json& j, const std::string& path, PassDesc& pass) {
+        static const std::vector<std::string> kKeys = {"id", "module", "enabled", "params", "inputs", "note",
+                                                       "remove", "before", "after"};
         if (!j.is_object()) {
             error(path, std::string("a pass is an object {\"id\": ..., \"module\": ...}, got ") + jsonTypeName(j));
-            return;
+            return true;
         }
         bool hasId = false, hasModule = false;
         for (auto it = j.begin(); it != j.end(); ++it) {
@@ -136,7 +145,11 @@ public:
                 hasModule = true;
                 if (expect(v, Json::value_t::string, "string", p)) pass.module = v.get<std::string>();
             } else if (key == "enabled") {
-                if (expect(v, Json::value_t::boolean, "bool", p)) pass.enabled = v.get<bool>();
+                if (expect(v, Json::value_t::boolean, "bool", p)) pass.enabled = v.get<bool>(), pass.enabledGiven = true;
+            } else if (key == "remove") {
+                if (expect(v, Json::value_t::boolean, "bool", p)) pass.remove = v.get<bool>();
+            } else if (key == "before" || key == "after") {
+                if (expect(v, Json::value_t::string, "string", p)) (key == "before" ? pass.placeBefore : pass.placeAfter) = v.get<std::string>();
             } else if (key == "note") {
                 if (expect(v, Json::value_t::string, "string", p)) pass.note = v.get<std::string>();
             } else if (key == "params") {
@@ -146,6 +159,10 @@ public:
                 if (!expect(v, Json::value_t::object, "object", p)) continue;
                 for (auto ii = v.begin(); ii != v.end(); ++ii) {
                     const std::string ip = keyPath(p, ii.key());
+                    if (ii.value().is_null()) {  // in an extending file: unbind the base's (resolveExtends)
+                        pass.inputs.emplace_back(ii.key(), std::string());
+                        continue;
+                    }
                     if (!ii.value().is_string()) {
                         error(ip, std::string("an input binding is a string \"<pass id>.<output>\", got ") +
                                       jsonTypeName(ii.value()) + " " + elide(ii.value().dump()));
@@ -158,17 +175,20 @@ public:
             }
         }
         if (!hasId) error(path, "missing \"id\" (a name for this pass, [a-z0-9_]+)");
-        if (!hasModule) error(path, "missing \"module\" (the pass module to run, e.g. \"gbuffer\")");
+        if (!pass.placeBefore.empty() && !pass.placeAfter.empty())
+            error(path, "\"before\" and \"after\" both given: a pass goes in one place");
+        return hasModule;
     }
 
     void readPipeline(const Json& root, PipelineDesc& desc) {
-        static const std::vector<std::string> kKeys = {"$schema", "note", "output", "passes"};
+        static const std::vector<std::string> kKeys = {"$schema", "extends", "note", "output", "passes"};
         if (!root.is_object()) {
             error("", std::string("a pipeline file is a JSON object {\"output\": ..., \"passes\": [...]}, got ") +
                           jsonTypeName(root));
             return;
         }
         bool hasPasses = false;
+        std::vector<size_t> withoutModule;
         for (auto it = root.begin(); it != root.end(); ++it) {
             const std::string& key = it.key();
             const Json& v = it.value();
@@ -176,18 +196,27 @@ public:
                 if (expect(v, Json::value_t::string, "string", key)) desc.schema = v.get<std::string>();
             } else if (key == "note") {
                 if (expect(v, Json::value_t::string, "string", key)) desc.note = v.get<std::string>();
+            } else if (key == "extends") {
+                if (expect(v, Json::value_t::string, "string", key)) desc.extends = v.get<std::string>();
             } else if (key == "output") {
                 if (expect(v, Json::value_t::string, "string", key)) desc.output = v.get<std::string>();
             } else if (key == "passes") {
                 hasPasses = true;
                 if (!expect(v, Json::value_t::array, "array", key)) continue;
                 desc.passes.resize(v.size());
-                for (size_t i = 0; i < v.size(); ++i) readPass(v[i], indexPath("passes", i), desc.passes[i]);
+                for (size_t i = 0; i < v.size(); ++i)
+                    if (!readPass(v[i], indexPath("passes", i), desc.passes[i]) && !desc.passes[i].remove)
+                        withoutModule.push_back(i);
             } else {
                 unknownKey("", key, kKeys);
             }
         }
-        if (!hasPasses) error("", "missing \"passes\" (the list of passes, in execution order)");
+        // A file that extends another may only change the base's passes, or none.
+        if (desc.extends.empty()) {
+            for (size_t i : withoutModule)
+                error(indexPath("passes", i), "missing \"module\" (the pass module to run, e.g. \"gbuffer\")");
+            if (!hasPasses) error("", "missing \"passes\" (the list of passes, in execution order)");
+        }
     }
 
 private:

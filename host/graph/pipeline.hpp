@@ -29,6 +29,7 @@
 #include "kiln/json_text.hpp"
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <utility>
@@ -57,15 +58,33 @@ struct PassDesc {
     std::string module;
     bool enabled = true;
     std::vector<std::pair<std::string, ParamLiteral>> params;  // in file order
-    std::vector<std::pair<std::string, std::string>> inputs;   // slot → "<pass id>.<output>"
+    std::vector<std::pair<std::string, std::string>> inputs;   // slot → "<pass id>.<output>" ("" from null)
     std::string note;
+
+    // Only in a file that extends another (PipelineDesc::extends), to say how it changes
+    // the base: drop the base's pass of this id; put an added or moved pass before or
+    // after the pass of that id. "enabled" written, so a changed pass takes it.
+    bool remove = false;
+    std::string placeBefore, placeAfter;
+    bool enabledGiven = false;
+    // After resolveExtends: where the entry that last wrote this pass is, for messages
+    // (the file of the chain and the index in its "passes"); empty file: fileName's own.
+    struct Origin {
+        std::string file;
+        int index = -1;
+    } origin;
 };
+
+// A parameter value typed on a command line (--set PASS.PARAM=VALUE): VALUE as JSON
+// (1024, 0.5, true, [1, 0.5, 0.2], "text"), or a bare word as a string (an enum choice).
+ParamLiteral parseParamLiteral(const std::string& value);
 
 // Sets (or adds, at the end) the file's value of parameter `name`.
 void setParamLiteral(PassDesc&, const std::string& name, const ParamValue&);
 
 struct PipelineDesc {
     std::string fileName;             // for messages; "pipelines/default.json"
+    std::string extends;              // "extends": the base file, relative to this one; "" once resolved
     std::string schema;               // "$schema", kept so writing back keeps it
     std::string note;
     std::string output;               // "<pass id>.<output>"; "" when missing
@@ -82,6 +101,26 @@ struct PipelineDesc {
 inline constexpr size_t kMaxPipelineFileBytes = size_t(16) << 20;
 
 Result<PipelineDesc> parsePipeline(const std::string& text, const std::string& fileName);
+
+// "extends": "default.json" makes a file the changes to another (the path relative to the
+// file; a chain of up to 16). Each of its passes' entries, by id:
+//   - a pass the base lacks, with a "module": added, at the end or "before"/"after" a pass;
+//   - a pass the base has, with a "module": replaced whole (and moved, with before/after);
+//   - a pass the base has, without one: its "params" and "inputs" set over the base's,
+//     key by key (null takes one away: a parameter back to its default, an input
+//     unbound), and "enabled" and "note" where written;
+//   - "remove": true: the base's pass dropped.
+// "output" and the notes, where written, replace the base's. Errors are the file's of the
+// chain they are in; each resolved pass keeps its entry's place (PassDesc::origin), so
+// the compiler's errors point there too.
+// The reader returns a file's text, or false and why not.
+using PipelineReader = std::function<bool(const std::string& file, std::string& text, std::string& why)>;
+// `desc` as parsePipeline gave it; on success the whole pipeline, with `extends` cleared.
+// A relative "extends" is looked for beside the file, then in each of `searchDirs` (the
+// shipped pipelines/), as #include "..." is: "default.json" works from anywhere.
+// `chain`: the files read, `desc`'s first (all of them want watching).
+Result<PipelineDesc> resolveExtends(PipelineDesc desc, const PipelineReader&, std::vector<std::string>* chain = nullptr,
+                                    const std::vector<std::string>& searchDirs = {});
 
 // Writes a pipeline back as pretty JSON (2-space indent, keys in the canonical
 // order; "enabled" only when false, empty params/inputs left out).
@@ -107,7 +146,8 @@ std::string writePipeline(const PipelineDesc&);
 //     back on keeps an explicit `"enabled": true` (not removed: removing a key means
 //     guessing which comma and whitespace go with it, and the explicit key shows where to
 //     toggle it again).
-// Anything else that differs is not a value edit — passes added, removed or reordered, a
+// A file that extends another (PipelineDesc::extends) is refused: its passes are partly
+// the other file's. Anything else that differs is not a value edit — passes added, removed or reordered, a
 // pass's id, module, inputs (including their order) or note, the pipeline's output, note
 // or $schema, a parameter the file has but `edited` lacks, a parameter named twice in
 // `edited`, a value JSON cannot hold (NaN/Inf, invalid UTF-8) — and nothing is returned:

@@ -358,6 +358,10 @@ std::optional<std::string> patchPipelineText(const std::string& original, const 
         return std::nullopt;
     }
     const PipelineDesc& file = parsed.value();
+    if (!file.extends.empty()) {
+        error = "it extends " + file.extends + ", so its passes are partly that file's (not a value edit of this one)";
+        return std::nullopt;
+    }
     if (std::string why = structuralDifference(file, edited); !why.empty()) {
         error = why + " (not a value edit)";
         return std::nullopt;

@@ -62,9 +62,52 @@ bool Runtime::loadPipelineText(const std::string& text, const std::string& displ
         errors = parsed.errorText();
         return false;
     }
-    if (!loadPipelineDesc(std::move(*parsed), errors)) return false;
+    // The files it extends are read relative to it, with the same bounds as the first.
+    const graph::PipelineReader read = [](const std::string& file, std::string& out, std::string& why) {
+        return json_text::readBoundedFile(file, graph::kMaxPipelineFileBytes, "pipeline file", out, why);
+    };
+    std::vector<std::string> chain;
+    auto resolved = graph::resolveExtends(std::move(*parsed), read, &chain, options_.pipelineSearchDirs);
+    if (!resolved) {
+        errors = resolved.errorText();
+        return false;
+    }
+    if (!applyOverrides(*resolved, errors) || !loadPipelineDesc(std::move(*resolved), errors)) return false;
     pipelineText_ = text;
     pipelineFile_ = displayName;
+    pipelineChain_.assign(chain.begin(), chain.end());
+    return true;
+}
+
+bool Runtime::applyOverrides(graph::PipelineDesc& desc, std::string& errors) {
+    std::vector<std::string> ids;
+    for (const graph::PassDesc& p : desc.passes) ids.push_back(p.id);
+    for (const ParamOverride& o : overrides_) {
+        const std::string origin = "--set " + o.text + ": ";
+        const int index = desc.find(o.pass);
+        if (index < 0) {
+            errors = origin + "no pass \"" + o.pass + "\" in " + desc.fileName + suggestion(o.pass, ids, "passes");
+            return false;
+        }
+        graph::PassDesc& pass = desc.passes[size_t(index)];
+        auto decl = modules_->declaration(pass.module);
+        if (!decl) continue;  // the compiler names the module's problem, at its place in the file
+        std::vector<std::string> names;
+        for (const ParamDecl& d : decl->params) names.push_back(d.name);
+        auto param = std::find_if(decl->params.begin(), decl->params.end(), [&](const ParamDecl& d) { return d.name == o.param; });
+        if (param == decl->params.end()) {
+            errors = origin + "module " + pass.module + " has no parameter \"" + o.param + "\"" +
+                     suggestion(o.param, names, "parameters");
+            return false;
+        }
+        std::string problem;
+        const std::optional<ParamValue> value = graph::checkParamLiteral(graph::parseParamLiteral(o.value), *param, problem);
+        if (!value) {
+            errors = origin + problem;
+            return false;
+        }
+        graph::setParamLiteral(pass, o.param, *value);
+    }
     return true;
 }
 

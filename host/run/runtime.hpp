@@ -31,6 +31,8 @@ namespace kiln::run {
 struct RuntimeOptions {
     std::vector<std::filesystem::path> shaderRoots;
     std::vector<std::filesystem::path> moduleDirs;
+    // Where a pipeline's relative "extends" is looked for after beside the file.
+    std::vector<std::string> pipelineSearchDirs;
     int width = 720, height = 720;
     uint64_t textureBudgetBytes = 8ull << 30;  // all textures of a plan together
 };
@@ -58,6 +60,16 @@ public:
     // Textures the debug view shows or --dump wants ("pass.output"): un-culls their
     // producers without touching anyone's textures.
     void setRequested(std::vector<std::string> requested);
+    // Parameter values from the command line (--set PASS.PARAM=VALUE), laid over every
+    // pipeline file loaded from then on, live reloads included. Each is checked as the
+    // file's values are; an error names the --set, not a place in the file. They become
+    // part of the running description, so the debug view's write-back writes them too.
+    struct ParamOverride {
+        std::string text;  // "PASS.PARAM=VALUE", as typed, for messages
+        std::string pass, param, value;
+    };
+    void setOverrides(std::vector<ParamOverride> overrides) { overrides_ = std::move(overrides); }
+
     // New output size; refused (textures unchanged, `error` says why) when the plan's
     // textures would not fit the GL limits or the budget at that size.
     bool resize(int width, int height, std::string& error);
@@ -88,6 +100,8 @@ public:
     const TextureRef* findTexture(std::string_view pass, std::string_view name) const;
     const graph::Plan* plan() const { return plan_ ? &*plan_ : nullptr; }
     const std::string& pipelineFile() const { return pipelineFile_; }
+    // The pipeline file and the files it extends, in that order (graph::resolveExtends).
+    const std::vector<std::filesystem::path>& pipelineChain() const { return pipelineChain_; }
     // The pipeline file's text as last loaded, and the description now running (the
     // loaded one with the debug view's edits).
     const std::string& pipelineText() const { return pipelineText_; }
@@ -140,13 +154,16 @@ private:
     static std::string offUntilChanged(const LoadedModule&);
     void recoverFromFaults();
     void recompilePlan();
+    bool applyOverrides(graph::PipelineDesc&, std::string& errors);
 
     RuntimeOptions options_;
     std::unique_ptr<ModuleRegistry> modules_;
     std::unique_ptr<ShaderLibrary> shaders_;
     std::optional<graph::Plan> plan_;
     std::string pipelineText_, pipelineFile_;
+    std::vector<std::filesystem::path> pipelineChain_;
     std::optional<graph::PipelineDesc> desc_;
+    std::vector<ParamOverride> overrides_;
     FrameCost lastCost_, cost_;
     std::vector<std::string> requested_;
     std::vector<std::unique_ptr<PassSlot>> slots_;  // parallel to plan_->passes

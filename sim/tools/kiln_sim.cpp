@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "bench.hpp"
+#include "command_line/command_line.hpp"
 #include "kiln/data_root.hpp"
 #include "kiln/sim/world.hpp"
 
@@ -17,40 +18,11 @@ using namespace kiln::sim;
 
 namespace {
 
-const char* kUsage = R"(kiln-sim - Kiln's physics without OpenGL
-
-usage:
-  kiln-sim run   [--scene FILE] [--steps N] [--seed S] [--mode course|accurate]
-                 [--contact four_spheres|exact]
-      loads the scene, steps the world N frames (default 1000) and prints the state
-      hash and the invariants (finite state, |q| - 1, containment); exits 1 if an
-      invariant is broken
-  kiln-sim bench [--scene FILE] [--out DIR] [--quick]
-      cost per frame for the scene and 10/100/1000 balls; the tumbler's rocking
-      period (vs the quadrature reference) and 3D energy/Jellett drift vs dt and
-      sub-steps with time per simulated second and the observed order; marbles vs
-      the closed-form free fall; four-sphere vs exact tumbler contact (poses and a
-      crowded scene); prints tables, writes CSV and PNG plots to DIR (default
-      bench-out/)
-  kiln-sim --help
-
-The default scene is scenes/cornell.json of the source tree.
-)";
-
 int fail(const std::string& m) {
     std::fprintf(stderr, "kiln-sim: error: %s\n", m.c_str());
     return 1;
 }
 
-bool parseCount(const std::string& v, long long& out) {
-    if (v.empty()) return false;
-    char* end = nullptr;
-    errno = 0;
-    const long long n = std::strtoll(v.c_str(), &end, 10);
-    if (*end || errno || n < 0) return false;
-    out = n;
-    return true;
-}
 
 }  // namespace
 
@@ -87,49 +59,35 @@ int runScene(const Scene& scene, const std::string& scenePath, long long steps) 
 }
 
 int main(int argc, char** argv) {
-    std::vector<std::string> args(argv + 1, argv + argc);
-    for (auto& a : args)
-        if (a == "--help" || a == "-h") {
-            std::printf("%s", kUsage);
-            return 0;
-        }
-    if (args.empty()) return fail("no command (run or bench); see kiln-sim --help");
-    const std::string command = args[0];
-    if (command != "run" && command != "bench") return fail("unknown command \"" + command + "\"; see kiln-sim --help");
-
+    CLI::App app{"kiln-sim — Kiln's physics without OpenGL", "kiln-sim"};
+    kiln::cli::configure(app);
+    app.require_subcommand(1);
     std::string scenePath = (kiln::shippedFiles().data / "scenes/cornell.json").string(), outDir = "bench-out", mode, contact;
     long long steps = 1000, seed = -1;
     bool quick = false;
-    for (size_t i = 1; i < args.size(); ++i) {
-        const std::string& a = args[i];
-        if (a == "--quick" && command == "bench") {
-            quick = true;
-            continue;
-        }
-        const bool known = a == "--scene" || (command == "bench" && a == "--out") ||
-                           (command == "run" && (a == "--steps" || a == "--seed" || a == "--mode" || a == "--contact"));
-        if (!known) return fail("unknown option \"" + a + "\" for " + command + "; see kiln-sim --help");
-        if (i + 1 >= args.size()) return fail(a + " needs a value");
-        const std::string& v = args[++i];
-        if (a == "--scene") scenePath = v;
-        else if (a == "--out") outDir = v;
-        else if (a == "--mode") mode = v;
-        else if (a == "--contact") contact = v;
-        else if (!parseCount(v, a == "--steps" ? steps : seed))
-            return fail(a + " " + v + ": expected a non-negative integer");
-    }
+    CLI::App* run = app.add_subcommand("run", "step the world N frames and print the state hash and the invariants (finite "
+                                              "state, |q| - 1, containment); exits 1 if one is broken");
+    run->add_option("--scene", scenePath, "the scene (default scenes/cornell.json)")->type_name("FILE");
+    run->add_option("--steps", steps, "frames to step (default 1000)")->type_name("N")->check(CLI::NonNegativeNumber.description(""));
+    run->add_option("--seed", seed, "the simulation's seed (default the scene's)")->type_name("N")->check(CLI::NonNegativeNumber.description(""));
+    run->add_option("--mode", mode, "the tumblers' dynamics")->check(CLI::IsMember({"course", "accurate"}));
+    run->add_option("--contact", contact, "the tumblers' contact model")->check(CLI::IsMember({"four_spheres", "exact"}));
+    CLI::App* bench = app.add_subcommand("bench", "cost per frame, the rocking period against quadrature, energy drift "
+                                                  "against dt, free fall, contact models; tables, CSV and plots in OUT");
+    bench->add_option("--scene", scenePath, "the scene (default scenes/cornell.json)")->type_name("FILE");
+    bench->add_option("--out", outDir, "where the CSV and plots go (default bench-out)")->type_name("DIR");
+    bench->add_flag("--quick", quick, "fewer, shorter runs");
+    if (const std::optional<int> exitNow = kiln::cli::parse(app, argc, argv)) return *exitNow;
+    const std::string command = run->parsed() ? "run" : "bench";
 
     SceneResult loaded = loadSceneFile(scenePath);
     if (!loaded) return fail(loaded.error.toString(scenePath));
     Scene scene = loaded.scene;
     if (seed >= 0) scene.physics.seed = uint64_t(seed);
     if (!mode.empty()) {
-        if (mode != "course" && mode != "accurate") return fail("--mode " + mode + ": expected course or accurate");
         scene.physics.tumblerMode = mode == "course" ? TumblerMode::Course : TumblerMode::Accurate;
     }
     if (!contact.empty()) {
-        if (contact != "exact" && contact != "four_spheres")
-            return fail("--contact " + contact + ": expected four_spheres or exact");
         scene.physics.tumblerContact = contact == "exact" ? TumblerContact::Exact : TumblerContact::FourSpheres;
     }
 

@@ -47,10 +47,10 @@ TEST_CASE("every shipped pipeline file parses", "[files]") {
 TEST_CASE("the schema knows the same keys as the parser", "[files]") {
     const nlohmann::json schema = nlohmann::json::parse(readFile(fs::path(KILN_PIPELINE_DIR) / "pipeline.schema.json"));
     CHECK(schema.at("$schema") == "https://json-schema.org/draft/2020-12/schema");
-    CHECK(keysOf(schema.at("properties")) == std::set<std::string>{"$schema", "note", "output", "passes"});
+    CHECK(keysOf(schema.at("properties")) == std::set<std::string>{"$schema", "extends", "note", "output", "passes"});
     CHECK(schema.at("additionalProperties") == false);
     const nlohmann::json& pass = schema.at("$defs").at("pass");
-    CHECK(keysOf(pass.at("properties")) == std::set<std::string>{"id", "module", "enabled", "note", "inputs", "params"});
+    CHECK(keysOf(pass.at("properties")) == std::set<std::string>{"id", "module", "enabled", "note", "inputs", "params", "remove", "before", "after"});
     CHECK(pass.at("additionalProperties") == false);
     CHECK(pass.at("properties").at("id").contains("$ref"));
     CHECK(schema.at("$defs").at("name").at("pattern") == "^[a-z0-9_]+$");

@@ -88,7 +88,7 @@ TEST_CASE("bad command-line values", "[integration][cli][robust]") {
                              "--watchdog 1.5", "--watch", "--watch --out w.png --no-live"}) {
         const Run r = runKiln(std::string("--headless ") + args, 60);
         INFO(args << "\n" << r.err);
-        CHECK(r.exitCode == 1);
+        CHECK(r.exitCode == 2);  // a usage error: nothing ran
         CHECK_THAT(r.err, Catch::StartsWith("kiln: error: "));
         CHECK(std::count(r.err.begin(), r.err.end(), '\n') == 1);  // one line
     }

@@ -126,7 +126,7 @@ TEST_CASE("kiln-bench-quality: a pipeline or scene file it cannot read is a usag
         Run r = runProgram(KILN_BENCH_QUALITY, std::string(option) + " no/such/file.json", 60);
         INFO(r.out << r.err);
         CHECK(r.exitCode == 2);
-        CHECK(r.err.find(std::string(option) + " no/such/file.json: cannot read the file") != std::string::npos);
+        CHECK(r.err.find(std::string(option) + ": no/such/file.json: cannot read the file") != std::string::npos);
         CHECK(r.out.find("reference") == std::string::npos);
     }
 }

@@ -123,17 +123,17 @@ TEST_CASE("a bad pipeline exits non-zero with the JSON path on stderr", "[integr
     fs::create_directories(TEST_OUTPUT_DIR);
     const fs::path file = fs::path(TEST_OUTPUT_DIR) / "bad.json";
     std::ofstream(file) << R"({"output": "composite.color", "passes": [ {"id": "gbuffer", "module": "gbufer"} ]})";
-    Run r = runKiln("--headless --size 32x32 --pipeline " + file.string());
+    Run r = runKiln("--headless --size 32x32 --stats --pipeline " + file.string());
     CHECK(r.exitCode != 0);
     CHECK_THAT(r.err, Catch::Contains("passes[0].module"));
     CHECK_THAT(r.err, Catch::Contains("gbuffer"));  // the suggestion
 }
 
-TEST_CASE("bad command lines exit non-zero with one line on stderr", "[integration][cli]") {
+TEST_CASE("bad command lines exit 2 with one line on stderr", "[integration][cli]") {
     for (const char* args : {"--size 12", "--frames -3", "--bogus", "--pipeline"}) {
         INFO(args);
         Run r = runKiln(args);
-        CHECK(r.exitCode != 0);
+        CHECK(r.exitCode == 2);
         CHECK(std::count(r.err.begin(), r.err.end(), '\n') == 1);
     }
 }
@@ -147,7 +147,7 @@ TEST_CASE("default files come from a Kiln tree in the working directory, else th
     fs::copy(fs::path(KILN_SOURCE_DIR) / "shaders", copy / "shaders", fs::copy_options::recursive);
     fs::copy(fs::path(KILN_SOURCE_DIR) / "scenes", copy / "scenes", fs::copy_options::recursive);
     std::ofstream(copy / "pipelines/default.json") << "{ broken";
-    const Run inCopy = runKiln("--headless --size 16x16", 60, copy.string());
+    const Run inCopy = runKiln("--headless --size 16x16 --stats", 60, copy.string());
     INFO(inCopy.err);
     CHECK(inCopy.exitCode == 1);
     CHECK_THAT(inCopy.err, Catch::Contains((copy / "pipelines/default.json").string()));
@@ -166,7 +166,7 @@ TEST_CASE("default files come from a Kiln tree in the working directory, else th
 
     // An empty entry in --shaders/--modules stands for the shipped directory: a list of
     // an empty directory and it renders; the same list without it finds no pass.
-    const std::string lists = " --shaders " + empty.string() + ": --modules " + empty.string();
+    const std::string lists = " --stats --shaders " + empty.string() + ": --modules " + empty.string();
     const Run withShipped = runKiln("--headless --size 16x16" + lists + ":", 120, empty.string());
     INFO(withShipped.err);
     CHECK(withShipped.exitCode == 0);

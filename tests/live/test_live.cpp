@@ -70,6 +70,38 @@ TEST_CASE("a pipeline edit changes the plan and keeps unchanged passes' textures
     CHECK(box.app.runtime().findTexture("gbuffer", "albedo")->id == albedo);
 }
 
+TEST_CASE("a pipeline that extends another reloads when either is saved, and a broken base names itself", "[live][gl]") {
+    Sandbox box("extends-edit", "mine.json",
+                R"({"extends": "default.json", "passes": [{"id": "composite", "params": {"exposure": 2.0}}]})");
+    auto state = [&](const char* id) {
+        const graph::Plan* plan = box.app.runtime().plan();
+        return plan->passes[size_t(plan->find(id))].state;
+    };
+    auto exposure = [&] {
+        const graph::Plan* plan = box.app.runtime().plan();
+        return std::get<float>(*plan->passes[size_t(plan->find("composite"))].params.find("exposure"));
+    };
+    REQUIRE(box.app.runtime().pipelineChain().size() == 2);
+    CHECK(exposure() == 2.0f);
+    // The base changes: the pipeline follows, the child's value kept.
+    const fs::path base = box.root / "pipelines/default.json";
+    std::string text = slurp(base);
+    const std::string from = R"({ "id": "shadow", "module": "shadow")";
+    REQUIRE(text.find(from) != std::string::npos);
+    text.replace(text.find(from), from.size(), R"({ "id": "shadow", "module": "shadow", "enabled": false)");
+    writeByRename(base, text);
+    CHECK(box.waitFor([&] { return state("shadow") == graph::PassState::Disabled; }));
+    CHECK(exposure() == 2.0f);
+    // A broken base: named, the running pipeline kept.
+    writeInPlace(base, "{ broken");
+    CHECK(box.waitFor([&] { return box.errorMentions("pipelines/default.json:1:3"); }));
+    CHECK(state("shadow") == graph::PassState::Disabled);
+    // The child changes.
+    writeByRename(box.root / "pipelines/mine.json", R"({"extends": "default.json", "passes": []})");
+    writeByRename(base, slurp(fs::path(KILN_SOURCE_DIR) / "pipelines/default.json"));
+    CHECK(box.waitFor([&] { return state("shadow") != graph::PassState::Disabled && exposure() == 1.0f; }));
+}
+
 TEST_CASE("a rebuilt module is swapped in with its parameters kept, unsaved edits included, a broken one is refused", "[live][gl]") {
     const std::string pipeline = R"({"output": "tint.color",
         "passes": [{"id": "tint", "module": "live_tint", "params": {"level": 0.25}}]})";

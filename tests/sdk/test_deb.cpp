@@ -40,7 +40,7 @@ TEST_CASE("cpack -G DEB: the layout under /usr, Debian dependencies, and it runs
                              "./usr/include/kiln/pass.hpp", "./usr/include/kiln/loader/glad/gl.h",
                              "./usr/share/kiln/pipelines/default.json", "./usr/share/kiln/shaders/common/fullscreen.vert",
                              "./usr/share/kiln/scenes/cornell.json", "./usr/lib/cmake/Kiln/KilnConfig.cmake",
-                             "./usr/lib/cmake/Kiln/KilnModule.cmake"})
+                             "./usr/lib/cmake/Kiln/KilnModule.cmake", "./usr/share/man/man1/kiln.1"})
         CHECK(files.count(file) == 1);
     // Every pass folder of the tree ships its module; no test module or test program ships.
     for (const auto& entry : fs::directory_iterator(fs::path(KILN_SOURCE_DIR) / "passes"))

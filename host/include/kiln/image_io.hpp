@@ -26,6 +26,9 @@ bool writePng(const std::string& path, const FloatImage& img, int channels, std:
 // EXR expects; readExr gives RGBA floats bottom row first, like readTexture.
 bool writeExr(const std::string& path, const FloatImage& img, std::string& error);
 bool readExr(const std::string& path, FloatImage& out, std::string& error);
+// Portable float map: 32-bit float RGB, little-endian, bottom row first (the format's own
+// order, as GL's); readable by oiiotool, ImageMagick and most HDR viewers.
+bool writePfm(const std::string& path, const FloatImage& img, std::string& error);
 
 }  // namespace kiln
 
