@@ -29,7 +29,7 @@
 // Chains a mode does not build are cleared to zero once and left alone; binding one
 // is a pipeline error (producedWhen), so no cone reads them.
 //
-// Bounces (issue 22). voxelize's radiance holds direct light and emission, so the
+// Bounces. voxelize's radiance holds direct light and emission, so the
 // pixels' cones gather one bounce; in a closed, bright box the later ones are a large
 // share (one bounce showed 0.62× the reference's indirect light). With bounces = k > 1
 // and voxelize's `albedo` and `normal` bound, the chains are built, then k − 1 times:

@@ -836,7 +836,7 @@ TEST_CASE("composite shadow_filter pcss: the tumbler's shadow keeps its core and
     INFO("edge widths (cm): one lookup " << edgeWidth(hard) << ", pcss " << edgeWidth(soft));
     CHECK(edgeWidth(soft) > edgeWidth(hard));
     // The core stays dark: well under the lit floor. Measured 0.51 of it (0.47 before
-    // issue 22's facing voxels gave the floor more indirect light; one lookup 0.27: the
+    // the facing voxels gave the floor more indirect light; one lookup 0.27: the
     // lamp-sized penumbra reaches into a 20 cm shadow); 0.7 fails a filter that washes
     // the core out.
     INFO("core " << soft.front() << " (one lookup " << hard.front() << "), lit " << soft.back());

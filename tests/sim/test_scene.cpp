@@ -125,7 +125,7 @@ TEST_CASE("the shipped scene carries the renderer's values", "[sim][scene]") {
     CHECK(again.scene.tumblers[0].position == glm::dvec2(0.1, -0.2));
 }
 
-// ---- Hostile scene files (issue 14): every one is a named error, none throws, hangs
+// ---- Hostile scene files: every one is a named error, none throws, hangs
 // or overflows the stack.
 
 TEST_CASE("a number beyond double range is a named error at its JSON path", "[sim][scene][bad-input]") {
