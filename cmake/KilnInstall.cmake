@@ -25,13 +25,9 @@ if(kiln_passes)
   install(TARGETS ${kiln_passes} LIBRARY DESTINATION ${KILN_INSTALL_MODULEDIR})
 endif()
 
-# Only what a pass sees: kiln/pass.hpp and what it includes, the hash a pass may key
-# its caches with, and the display gamma's fit for a pass that tonemaps. The host's own
-# headers stay in the tree.
-install(FILES host/include/kiln/pass.hpp host/include/kiln/declare.hpp host/include/kiln/gl.hpp
-              host/include/kiln/scene_view.hpp host/include/kiln/shader.hpp host/include/kiln/hash.hpp
-              host/include/kiln/gamma_fit.hpp
-        DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/kiln)
+# The SDK is host/include/kiln/, whole: what a pass sees is what installs, one list. The
+# host's own headers (host/core/include/kiln/) stay in the tree.
+install(DIRECTORY host/include/kiln DESTINATION ${CMAKE_INSTALL_INCLUDEDIR} FILES_MATCHING PATTERN "*.hpp")
 if(KILN_WITH_GL)
   install(DIRECTORY ${CMAKE_BINARY_DIR}/glad/include/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/kiln/loader)
 endif()

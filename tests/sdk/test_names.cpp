@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <regex>
+#include <set>
 #include <string>
 
 #include "support/run_kiln.hpp"
@@ -40,5 +41,41 @@ TEST_CASE("the installed SDK headers name no object of the demo scene", "[sdk]")
     INFO(found);
     CHECK(headers >= 5);  // pass, declare, gl, scene_view, shader at least
     CHECK(found.empty());
+    fs::remove_all(prefix);
+}
+
+TEST_CASE("the SDK is one directory: what installs is what an in-tree pass can include", "[sdk]") {
+    const fs::path prefix = fs::path(TEST_OUTPUT_DIR) / ("sdk-list-" + std::to_string(getpid()));
+    kiln::test::removeEarlierRuns(prefix);
+    auto install = kiln::test::runProgram(CMAKE_COMMAND, "--install '" + std::string(KILN_BUILD_DIR) + "' --prefix '" +
+                                                             prefix.string() + "'", 600);
+    INFO(install.out << install.err);
+    REQUIRE(install.exitCode == 0);
+    auto headersIn = [](const fs::path& dir) {
+        std::set<std::string> names;
+        for (const fs::directory_entry& e : fs::directory_iterator(dir))
+            if (e.path().extension() == ".hpp") names.insert(e.path().filename().string());
+        return names;
+    };
+    const std::set<std::string> sdk = headersIn(fs::path(KILN_SOURCE_DIR) / "host/include/kiln");
+    CHECK(headersIn(prefix / "include/kiln") == sdk);
+    // The host's own headers are elsewhere, none of them in the SDK's directory.
+    for (const std::string& hostOnly : headersIn(fs::path(KILN_SOURCE_DIR) / "host/core/include/kiln")) {
+        INFO(hostOnly);
+        CHECK(sdk.count(hostOnly) == 0);
+    }
+    // An in-tree pass builds with the SDK's include path only: none includes a host header.
+    for (const fs::directory_entry& e : fs::recursive_directory_iterator(fs::path(KILN_SOURCE_DIR) / "passes")) {
+        if (e.path().extension() != ".cpp" && e.path().extension() != ".hpp") continue;
+        std::ifstream in(e.path());
+        for (std::string line; std::getline(in, line);) {
+            std::smatch m;
+            static const std::regex include(R"(#include\s*[<"]kiln/([a-z_]+\.hpp)[>"])");
+            if (std::regex_search(line, m, include)) {
+                INFO(e.path().string() << ": " << line);
+                CHECK(sdk.count(m[1].str()) == 1);
+            }
+        }
+    }
     fs::remove_all(prefix);
 }
