@@ -44,10 +44,10 @@ public:
             .param(floatParam("intensity", 0.6f, 0.0, 8.0, "scales the blurred light"))
             .param(enumParam("bright_stores", "auto", {"auto", "sparse", "dense"},
                              "how the bright-pass leaves its dark texels black (the same picture either way): "
-                             "sparse clears its texture and stores only the bright texels (llvmpipe at 720²: "
-                             "0.35 ms less than dense with two fireballs, 0.45 with fifty); dense stores every "
-                             "texel and clears nothing (an H200: 0.21 against 0.29 ms at 1080p, 0.81 against "
-                             "1.14 at 4K: a cleared texture written by a shader costs it more than the writes); "
+                             "sparse clears its texture and stores only the bright texels (cheaper on "
+                             "a CPU rasterizer); dense stores every texel and clears nothing (cheaper "
+                             "on a GPU, where a cleared texture written by a shader costs more than "
+                             "the writes); "
                              "auto: sparse on a CPU rasterizer (llvmpipe, softpipe), dense on anything else"));
         return d;
     }

@@ -100,9 +100,9 @@ public:
                              "particles write only emission: they are not followed)"))
             .param(intChoiceParam("direct_tile", 64, {16, 32, 64},
                                   "keep_direct: side in pixels of the square tiles the lamp's light is recomputed "
-                                  "over. 64: llvmpipe's own tiles (at 16, composite took 20.1 against 17.4 ms at "
-                                  "720² moving, though it recomputed 36 % of the picture against 45 %: llvmpipe "
-                                  "sets up each small triangle in each of its tiles)"));
+                                  "over. 64: llvmpipe's own tiles (smaller ones recompute less of the "
+                                  "picture but cost more: llvmpipe sets up each small triangle in each "
+                                  "of its tiles)"));
         d.reads = kSceneLights | kSceneCamera | kSceneGlowingSpheres;
         return d;
     }
@@ -114,8 +114,8 @@ public:
         // for `traced` (cone_trace's samples, every frame) and pcss (a blocker search
         // of unbounded reach).
         const bool keep = ctx.getBool("keep_direct") && lampModel != "traced" && !pcss;
-        // `hdr` only when something reads it (the error metrics, the debug view): 0.9 ms
-        // at 720² on llvmpipe for a target nothing in the default pipeline reads.
+        // `hdr` only when something reads it (the error metrics, the debug view): a
+        // target nothing in the default pipeline reads is not worth its cost on llvmpipe.
         hdr_ = ctx.isRead("hdr");
         // The display's gamma as a polynomial where it fits (kiln/gamma_fit.hpp).
         if (ctx.getFloat("gamma") != fittedGamma_)
@@ -291,8 +291,8 @@ private:
     // keep_direct: which tiles moved (moved_tiles.comp, tile_lists.comp), the lamp's
     // light recomputed and kept over those, the rest shaded from what was kept. When
     // most of the picture moved at the last count, drawing it in tiles costs more than
-    // the whole (llvmpipe, 720²: all tiles recomputed 22 ms, the plain pass 20; 50
-    // fireballs move 65 % of the tiles): DrawWhole, and the tiles are only counted.
+    // the whole (all tiles recomputed cost more than the plain pass, and many fireballs
+    // move most of the tiles): DrawWhole, and the tiles are only counted.
     enum class Kept { Drawn, DrawWhole, Failed };
     Kept drawKeepingDirect(kiln::PassContext& ctx, GLuint program, GLuint nearProgram, GLuint cachedProgram,
                            const kiln::PixelRect& nearRect) {
@@ -332,8 +332,8 @@ private:
         drawingWhole_ = !inTiles;
         // Drawing whole, the tiles are only counted, to know when to come back to them:
         // every kCountWholeEvery-th run, the run before it keeping the instances to
-        // compare with (marking 50 fireballs' 4 000 particles each run, when they were
-        // followed, cost composite 1 ms at 720² for nothing drawn).
+        // compare with (marking many fireballs' thousands of particles each run, when
+        // they were followed, cost composite time for nothing drawn).
         bool keepOnly = false;
         if (!inTiles) {
             const uint32_t phase = wholeRuns_++ % kCountWholeEvery;
@@ -506,8 +506,9 @@ private:
     // keep_direct (the pass's own objects: a reload starts over).
     // tile_lists.comp's buffer: two draw commands, the count of moved tiles at [8], the lists.
     static constexpr uint32_t kMovedCountAt = 8, kListsStart = 12;
-    // The share of moved tiles above which the whole is drawn (llvmpipe at 720²: in tiles
-    // 11.7 ms + 10.4 × the share, whole 20), and below which tiles come back.
+    // The share of moved tiles above which the whole is drawn (on llvmpipe drawing in
+    // tiles costs a fixed part plus one growing with the share, against the whole's
+    // flat cost), and below which tiles come back.
     static constexpr double kTilesUpTo = 0.75, kTilesBackBelow = 0.6;
     static constexpr uint32_t kCountWholeEvery = 8;
     bool drawingWhole_ = false;

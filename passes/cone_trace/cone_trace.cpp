@@ -34,7 +34,7 @@
 // `samples`, with the traced surface's plane in `planes`, then a depth/normal-aware
 // upsample writes `indirect`. output_divisor 2: `indirect` is half the picture's size
 // and composite's bilinear lookup does the last step (the upsample is a full-screen
-// pass: at 720² it cost as much as the stride-4 trace). output_samples N caps the
+// pass, as dear as a stride-4 trace). output_samples N caps the
 // output's texels across as trace_samples caps the samples: the upsample costs its
 // pixels, and where a sample stands for 12 × 12 of them a half-size output mostly
 // interpolates between the same four. Indirect light is smooth on
@@ -227,7 +227,8 @@ public:
         const kiln::TextureRef& voxels = ctx.input("voxels");
         kiln::Defines defines = schedule(ctx, voxels.width);
         defines.emplace_back("KILN_LAMP_IN_ALPHA", ctx.getBool("lamp") ? "1" : "0");
-        defines.emplace_back("KILN_LAMP_SAMPLES", "16");  // silhouette vertices: within 0.8 % (tests/gi/test_lamp.cpp)
+        // 16 silhouette vertices: within 1 % (tests/gi/test_lamp.cpp).
+        defines.emplace_back("KILN_LAMP_SAMPLES", "16");
         // The host sized `samples` by the same rule (kiln::sizeDivisor); normal is the output's size.
         const kiln::TextureRef& normal = ctx.input("normal");
         const int stride = kiln::sizeDivisor(ctx.getInt("trace_stride"), ctx.getInt("trace_samples"), normal.width,

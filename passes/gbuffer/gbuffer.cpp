@@ -62,9 +62,9 @@ public:
             (tracedSpheres && !sphereProgram))
             return;
         // The floor's grain, baked: sampled through its mips it is the grain averaged
-        // over each pixel, as the reference sees it (at 256²: floor relMSE 0.058
-        // against 0.075 evaluated at pixel centres, SSIM 0.789 against 0.772), for
-        // +1.6 ms at 720². Re-baked when the wood colours or the texture change.
+        // over each pixel, as the reference sees it (closer to it than the grain evaluated
+        // at pixel centres), for a little more G-buffer time. Re-baked when the wood
+        // colours or the texture change.
         const kiln::TextureRef& wood = ctx.internal("wood");
         const auto& f = ctx.scene().frame;
         if (wood.id != bakedTexture_ || f.ringsLight != bakedLight_ || f.ringsDark != bakedDark_ || bake != bakedWith_) {
@@ -82,18 +82,17 @@ public:
         kiln::forEachRedrawRect(ctx, target.width, target.height, 0, [&] {
             // Depth only: the colours are written where geometry is and by the background
             // after it (below), which the depth test keeps to the rest. The three colour
-            // clears cost llvmpipe 1.2 ms at 720².
+            // clears are dear on llvmpipe.
             const float one = 1.0f;
             glClearBufferfv(GL_DEPTH, 0, &one);
             glEnable(GL_DEPTH_TEST);
             glDepthFunc(GL_LESS);
             glUseProgram(program);
             // The bodies are closed, so their back faces never show: culled, they cost
-            // llvmpipe no setup (13.3 against 16.4 ms at 720²), and no back face wins a
-            // depth tie at a silhouette (3 pixels of 360² did). The walls and the lamp's dome
-            // are open surfaces, seen from either side. The bodies first: they stand in
-            // front of the walls, whose hidden fragments the depth test then rejects
-            // before shading (gbuffer 5.36 -> 5.21 ms at 720², three alternations).
+            // llvmpipe no setup, and no back face wins a depth tie at a silhouette (a few
+            // pixels did). The walls and the lamp's dome are open surfaces, seen from either
+            // side. The bodies first: they stand in front of the walls, whose hidden
+            // fragments the depth test then rejects before shading.
             glEnable(GL_CULL_FACE);
             glCullFace(GL_BACK);
             ctx.drawScene({.categories = tracedSpheres ? kiln::kSceneRoundCones : kiln::kSceneBodies});
@@ -131,7 +130,7 @@ private:
     // only their emission written, its alpha 2 (the `emissive` output's doc). Albedo,
     // normal and depth stay those of the surface behind, so a particle moving over it
     // changes none of what composite keeps of its lamp light: composite's kept tiles
-    // need not follow the particles (4 000 sparks with 50 fireballs moved 80 % of them),
+    // need not follow the particles (many fireballs' sparks would move most of them),
     // and cone_trace gathers for the surface, not for a spark a few pixels wide. One
     // particle over another: the one drawn later shows.
     void drawParticles(kiln::PassContext& ctx, GLuint program, bool points) {
@@ -143,7 +142,7 @@ private:
         glUseProgram(program);
         if (points) {
             // Thousands of particles a few pixels wide: one point each, not 8 triangles
-            // (4 000 octahedra cost the G-buffer 15 ms at 720² on llvmpipe).
+            // (thousands of octahedra are dear for llvmpipe, which sets up each on the CPU).
             glUniform1ui(glGetUniformLocation(program, "u_first"), ctx.scene().firstInstance(kiln::kSceneParticles));
             glEnable(GL_PROGRAM_POINT_SIZE);
             glBindVertexArray(emptyVertexArray());

@@ -11,12 +11,12 @@ namespace {
 // 93 texels per metre at a metre from the lamp, so a tumbler (lower radius 0.2) 1.5 m
 // below it spans a radius of 12 texels, where its mesh strays from the round cone by
 // r·(1 − cos(π/n)): 0.03 of a texel at 48 slices, 0.1 at 24, 0.4 at 12, 0.9 at 8 (the
-// voxelizer's; an inscribed 12-gon, 4.5 % short in area, already left the floor 0.5 %
-// too bright at 128², t = 0.5); at 1024² twice that. The medium tumbler is a 24-gon moved out to its
-// circle's area (host/scene/mesh.hpp). llvmpipe sets up every triangle on the CPU: at
-// 720² the map took 3.0 ms with the 48-slice tumblers, 1.3 with the medium ones; the
-// quality bench (relMSE 0.01248 -> 0.01251 at 128², t = 0.5) and test_scene's
-// "shadow caster_mesh" (covered texels within 0.3 %) see the same shadows.
+// voxelizer's; an inscribed 12-gon, 4.5 % short in area, already left the floor too
+// bright); at 1024² twice that. The medium tumbler is a 24-gon moved out to its
+// circle's area (host/scene/mesh.hpp). llvmpipe sets up every triangle on the CPU, so
+// the medium casters draw the map much faster than the 48-slice ones; the quality
+// bench and test_scene's "shadow caster_mesh" (its bounds on area and covered texels)
+// see the same shadows.
 kiln::Lod casterLod(kiln::PassContext& ctx) {
     const std::string& mesh = ctx.getEnum("caster_mesh");
     if (mesh == "auto") return ctx.getInt("size") <= 1024 ? kiln::Lod::Medium : kiln::Lod::Fine;

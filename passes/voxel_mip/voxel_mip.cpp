@@ -16,7 +16,8 @@
 //          (i&1, (i>>1)&1, i>>2). A cone with direction d takes three of them, chosen
 //          by sign arithmetic (x: (d.x<0, 0, 0), y: (d.y<0, 1, 0), z: (d.z<0, 0, 1)),
 //          weighted by d² — three fetches from one sampler, no branch (see
-//          docs/performance.md: six samplers behind a ?: cost ~7 fetches on llvmpipe).
+//          docs/performance.md: six samplers behind a ?: cost more than the three
+//          fetches on llvmpipe).
 //          The sampler must clamp coordinates half a texel inside the octant
 //          (shaders/cone_trace/voxels.glsl does).
 //   fixed_cones  (mode = fixed_cones) the aniso chains blended per direction of the
@@ -31,7 +32,7 @@
 //
 // Bounces. voxelize's radiance holds direct light and emission, so the
 // pixels' cones gather one bounce; in a closed, bright box the later ones are a large
-// share (one bounce showed 0.62× the reference's indirect light). With bounces = k > 1
+// share (one bounce showed well under the reference's indirect light). With bounces = k > 1
 // and voxelize's `albedo` and `normal` bound, the chains are built, then k − 1 times:
 // every block of gather_block³ voxels that holds a surface traces the fixed cone set
 // through them (shaders/voxel_mip/bounce.comp), level 0 becomes the input plus albedo ×
@@ -44,14 +45,14 @@
 // each surface voxel reflects of the light its block gathered last frame (the
 // `feedback` internal), the k − 1 bounces follow as above, and one more gather is kept
 // for the next frame. Frame n from a cold start shows n·k bounces; the frames converge
-// to every bounce (the furnace: 1.968 of 2), geometrically at about the albedo a frame,
+// to every bounce (the furnace: close to its 2), geometrically at about the albedo a frame,
 // and the reflected light is a frame behind motion. After a change the pass asks the
 // host for kFeedbackSettleFrames more frames (ctx.keepRunning), so a paused frame
 // converges and then is skipped again. One gather and one chain build a frame (k = 1)
-// instead of k − 1 and k: 5.7 ms at 720² against three bounces' 12.4. With `gather_list`
-// (default) the kept gather runs only over the blocks that hold a surface, listed each
-// frame for an indirect dispatch (bounce.comp's step 3; about a third of the 16³ blocks
-// in the shipped box): the same light, 5.7 → 3.7 ms.
+// instead of k − 1 and k: far cheaper than gathering three bounces in the frame. With
+// `gather_list` (default) the kept gather runs only over the blocks that hold a surface,
+// listed each frame for an indirect dispatch (bounce.comp's step 3; about a third of the
+// 16³ blocks in the shipped box): the same light, for less.
 //
 // Facing (`facing`, needs `normal`). A voxel holds one radiance and one opacity; a
 // cone leaving a surface met that surface's own voxels through the coarse levels, lit
@@ -59,10 +60,10 @@
 // base with each surface voxel that the direction meets from behind (its mean normal
 // along the direction of travel) emptied: rays from outside a closed surface never
 // meet its back (shaders/voxel_mip/aniso.comp). With the gather a diameter off its
-// surfaces it cut the over-reflection of a third bounce from 1.78× to 1.31× the path
-// tracer's increment, and with 54° pixel cones took the default's relMSE from 0.0443
-// to 0.0311 (README, "The voxels' faces"). The 1.31× left was the lookups past the
-// box's open front (cone_trace/voxels.glsl insideBox): 1.03× since.
+// surfaces it cut much of the over-reflection of a third bounce against the path
+// tracer's increment, and with 54° pixel cones brought the default closer to the
+// reference (README, "The voxels' faces"). Most of what was left was the lookups past
+// the box's open front (cone_trace/voxels.glsl insideBox), since fixed.
 #include <kiln/pass.hpp>
 
 #include <algorithm>

@@ -5,7 +5,7 @@
 // The lamp dome is voxelized as an occluder, its emission scaled by `lamp_emission`
 // (default 0): the lamp's light reaches every surface through composite's direct term
 // already; with its emission in the voxels too, the first bounce would add the lamp a
-// second time (measured: walls about twice as bright, colours washed out).
+// second time (measured: walls far too bright, colours washed out).
 //
 // How it works
 //   1. Draw the meshes into an attachment-less framebuffer of res×res pixels. The
@@ -30,18 +30,18 @@
 //      (spheres of about a voxel) on request (fireball_mode splat): a compute pass
 //      (voxelize/splat.comp) adds each one, as one fragment, to the voxels its surface
 //      passes through, a fireball's lit by the lamp as a fragment there would be.
-//      Rasterized, each particle cost 8 geometry-shader triangles: 50 fireballs'
-//      4 000 particles took voxelize from 14 to 61 ms at 720² (particle_mode "mesh").
+//      Rasterized, each particle cost 8 geometry-shader triangles: thousands of
+//      particles made voxelize far dearer (particle_mode "mesh").
 //      The fireballs stay meshes by default: their rasterized triangles give a voxel
-//      several fragments where the splat gives one, and the reference prefers that
-//      weight (relMSE 0.0645 against 0.0655 at 256²).
+//      several fragments where the splat gives one, and the reference slightly prefers
+//      that weight.
 //   The tumblers on request (tumbler_mode splat): a compute pass (voxelize/tumblers.comp)
 //      adds one fragment to each voxel their exact round cone's surface passes through,
 //      lit at the surface point nearest the voxel's centre; rasterizing their low-poly
-//      meshes through the geometry shader cost 3.2 of voxelize's 7.1 ms at 720², the
-//      splat 1.4. Not the default: against the reference the floor next to the tumblers
-//      is worse (relMSE 0.0124 against the mesh's 0.0114 at 256², t = 0), though every
-//      region's mean light is closer (the floor's indirect light 0.966 -> 1.003×).
+//      meshes through the geometry shader cost a large share of voxelize, the splat
+//      much less. Not the default: against the reference the floor next to
+//      the tumblers is worse, though every region's mean light is closer (the floor's
+//      indirect light among them).
 //   The particles' cover on request (fire_cover on), first: a compute pass
 //      (voxelize/fire_cover.comp) shares each particle's cross-section among the voxels
 //      it overlaps, resolved into `fire` (the optical depth across each voxel, with mips);
@@ -65,10 +65,10 @@
 // the walls' light changes with every moving shadow, so their fragments are recorded
 // (point, normal, albedo, voxels, and the lamp's unshadowed irradiance, which changes
 // only with the lamp) and voxelize/static_light.comp takes each one's shadow test again
-// each frame and adds its light, as the fragment shader would, to the frame's sums. At
-// 720² moving: the dome kept 7.9 -> 6.9 ms, the walls kept 6.9 -> 6.1 (lighting their
-// fragments again 0.7 of it, 0.3 less with the irradiance kept); the voxels are the
-// same, exactly (keep_static off rasterizes everything every frame; tests/gi/test_gi.cpp
+// each frame and adds its light, as the fragment shader would, to the frame's sums.
+// Keeping the dome, then the walls, each makes a moving frame cheaper (lighting the
+// walls' fragments again is cheaper still with their irradiance kept); the voxels are
+// the same, exactly (keep_static off rasterizes everything every frame; tests/gi/test_gi.cpp
 // compares the two). The host skips the pass when neither the scene
 // (static geometry, bodies, particles, light) nor the shadow map changed.
 #include <kiln/pass.hpp>
@@ -141,15 +141,13 @@ public:
                              "voxelized blob carries the sphere's flux"))
             .param(enumParam("fireball_mode", "mesh", {"mesh", "splat"},
                              "mesh: rasterize its sphere like every other mesh; splat: a compute pass adds each "
-                             "fireball, as one fragment, to the voxels its surface passes through (as accurate: "
-                             "relMSE 0.0128 against 0.0130 at 256^2, t = 0; 50 fireballs cost the 720^2 frame "
-                             "1.17x two where the mesh costs 1.32x)"))
+                             "fireball, as one fragment, to the voxels its surface passes through (as "
+                             "accurate, and many fireballs cost the frame less than their meshes do)"))
             .param(enumParam("tumbler_mode", "mesh", {"mesh", "splat"},
                              "mesh: rasterize the low-poly mesh like every other mesh; splat: a compute pass adds "
                              "one fragment to each voxel the exact shape's surface passes through "
-                             "(voxelize/tumblers.comp): voxelize 7.1 -> 5.3 ms at 720^2, but relMSE 0.0124 against "
-                             "0.0114 at 256^2, t = 0, and 0.0128 against 0.0125 at 128^2, t = 0.5 (the floor by "
-                             "the tumblers)"))
+                             "(voxelize/tumblers.comp): a cheaper voxelize, but further from the "
+                             "reference (the floor by the tumblers)"))
             .param(floatParam("lamp_emission", 0.0f, 0.0, 1.0,
                               "scale of the lamp dome's own emission in the voxels (its light already arrives "
                               "through composite's direct term: 1 counts it twice)"))
@@ -166,15 +164,15 @@ public:
             .param(intChoiceParam("transmittance_resolution", 32, {8, 16, 32, 64},
                                   "fire_cover on: nodes per side of `lamp_transmittance`, the grid the fraction of "
                                   "the lamp seen past the fire is computed on (each node marches the particles' "
-                                  "cover and tests the fireballs against the cap: 16³ cost 1.5 ms at 720² on "
-                                  "llvmpipe, 8³ 0.4). The lamp is large, so the fraction changes slowly away "
-                                  "from the fire"));
+                                  "cover and tests the fireballs against the cap: a finer grid costs "
+                                  "more). The lamp is large, so the fraction changes slowly away from "
+                                  "the fire"));
         d.reads = kSceneStatic | kSceneMeshes | kSceneBodies | kSceneParticles | kSceneLights;
         return d;
     }
 
     void execute(kiln::PassContext& ctx) override {
-        // 16 silhouette vertices (within 0.8 % of the exact irradiance; tests/gi/test_lamp.cpp)
+        // 16 silhouette vertices (within 1 % of the exact irradiance; tests/gi/test_lamp.cpp)
         // or the old 32 quadrature points.
         const bool contour = ctx.getEnum("lamp_model") == "contour", field = ctx.getEnum("lamp_model") == "field";
         const bool fireCover = ctx.getEnum("fire_cover") == "on";
@@ -369,9 +367,8 @@ private:
 
     // The fireballs or the particles, splatted by `splatter` (splat.comp: lit spheres or
     // emitters). One program with a branch between the two ran the fireballs' lighting for
-    // every particle (llvmpipe runs an `if` for every lane): 50 fireballs and their 4 000
-    // particles cost voxelize 1.75 ms at 720², apart 0.3 + 0.7. `groupSize`: the
-    // program's KILN_SPLAT_GROUP.
+    // every particle (llvmpipe runs an `if` for every lane), dearer than the two programs
+    // apart. `groupSize`: the program's KILN_SPLAT_GROUP.
     static void splat(kiln::PassContext& ctx, GLuint splatter, uint32_t groupSize, int res,
                       kiln::SceneCategory spheres) {
         const kiln::SceneView& scene = ctx.scene();
@@ -516,8 +513,8 @@ private:
     int fboSize_ = 0;
     static constexpr int kRasterTile = 64;  // llvmpipe shades a framebuffer in tiles of 64², one thread each
     // splat.comp's workgroups. The fireballs are few and each costs many voxels' lighting:
-    // eight to a group spreads fifty over llvmpipe's threads (0.3 ms), where 64 put them
-    // all on one (0.5).
+    // eight to a group spreads fifty over llvmpipe's threads, where 64 put them all on
+    // one, which is slower.
     static constexpr uint32_t kFireballGroup = 8, kParticleGroup = 64;
 };
 

@@ -3,17 +3,17 @@
 // of the full-resolution input (one bilinear lookup at its centre), keeps its part above
 // the threshold (colour scaled by (lum − threshold) / lum) and stores the
 // half-resolution texel — the threshold after the mean, as engines' prefilters do: four
-// texel fetches, each thresholded, cost llvmpipe 0.5 ms more at 720² (the blur hides
-// the difference). An invocation whose block passes also raises a flag, which the blur
+// texel fetches, each thresholded, cost llvmpipe more (the blur hides the difference).
+// An invocation whose block passes also raises a flag, which the blur
 // reads to write black without a tap when nothing passes. No reduction in shared
 // memory: on llvmpipe every barrier() suspends and resumes each invocation, and the
-// seven of a 64-wide tree cost more than the whole bright-pass (measured). Five atomics
-// from every bright texel cost it 1.3 ms at 720² with 50 fireballs' sparks on screen
-// (two threads contending for one cache line): each is taken only where it would change
-// the value, which after the first few texels is almost never (2.7 -> 1.4 ms).
+// seven of a 64-wide tree cost more than the whole bright-pass. Five atomics from every
+// bright texel are dear with many fireballs' sparks on screen (threads contending for
+// one cache line): each is taken only where it would change the value, which after the
+// first few texels is almost never.
 // KILN_BRIGHT_SPARSE 1: only the bright texels are stored, over the rectangle bloom.cpp
-// cleared (llvmpipe skips a masked lane's store): the bright-pass 1.6 -> 1.3 ms with the
-// default's two fireballs. 0: every texel is stored, dark ones black, and nothing is
+// cleared (llvmpipe skips a masked lane's store, so the bright-pass is cheaper on a CPU
+// rasterizer). 0: every texel is stored, dark ones black, and nothing is
 // cleared (on a GPU the cleared texture cost more than the stores: bloom.cpp's
 // bright_stores). Drawn as a fragment shader instead, the pass cost more.
 #ifndef KILN_BRIGHT_SPARSE

@@ -13,8 +13,8 @@
 //              lamp's cap (each a disc of its projected solid angle, weighted by its
 //              share of the irradiance): the part of each cell it overlaps is hidden.
 //              Few and about a voxel large: near exact here, where a voxel volume blurs
-//              them (one 10 cm fireball under the lamp hid 0.12 of it through a cover
-//              volume, 0.25 in fact: tests/gi/test_gi.cpp).
+//              them (one 10 cm fireball under the lamp, through a cover volume, hid
+//              far less of it than in fact: tests/gi/test_gi.cpp).
 //   particles  hundreds, a third of a voxel: voxelize.fire holds their cross-sections per
 //              voxel face (μ·h, mipped: the mean). One cone from p to the lamp, as wide
 //              at each distance as the lamp's disc seen from p, sums the optical depth
@@ -26,7 +26,7 @@ layout(binding = 10) uniform sampler3D u_fire;
 // The fireballs that may stand between p and the lamp, and fireball i of them (xyz its
 // centre, w its radius; at most kFireMaxFireballs). The includer defines them
 // (voxelize/fire_transmittance.comp: a list per workgroup in shared memory; every
-// fireball read from the instance buffer in every loop cost 14 ms at 50 fireballs).
+// fireball read from the instance buffer in every loop was far dearer with many fireballs).
 int fireballCount();
 vec4 fireballSphere(int i);
 

@@ -32,9 +32,9 @@ bool lampCutByHorizon(vec3 p, vec3 n) {
 // cuts it, n·F falls short of the clipped Φ (a dim band on curved bodies): there the
 // lamp is taken as the ball F describes (sin²σ = |F|/π, centred along F) and Φ is that
 // ball's horizon-clipped form (Snyder 1996, as in Lagarde & de Rousiers 2014, "Moving
-// Frostbite to PBR", §4.7.2). Composite +1.7 ms at 720² on llvmpipe (the same in a
+// Frostbite to PBR", §4.7.2). It makes composite dearer on llvmpipe (the same in a
 // loop run at most once, which llvmpipe leaves when no pixel of a group needs it); a
-// cheaper wrap, |F| (cos θ + sin σ)² / (4 sin σ), cost +0.8 ms but was further from the
+// cheaper wrap, |F| (cos θ + sin σ)² / (4 sin σ), cost less but was further from the
 // per-pixel contour in that band than n·F itself (tests/gi/test_lamp.cpp).
 float lampFieldSolidAngle(vec3 F, vec3 p, vec3 n) {
     float projected = dot(n, F);

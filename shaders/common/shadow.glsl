@@ -4,10 +4,9 @@
 // That point is the centroid of the emitter's surface (the cap of the lamp's ball below
 // the ceiling: its area grows evenly with depth, so the centroid sits half way down
 // it), not the ball's centre above the ceiling: a hard shadow cast from the centre is
-// shorter than the lamp's penumbra centred on the cap. kiln-bench-quality, the floor's
-// direct light against the path tracer: 1.133x -> 1.106x at 128^2, t = 0.5; 1.042x ->
-// 1.014x at 256^2, t = 0 (both frames' relMSE lower). Casters within kLightNear below
-// that point or above it (a marble by the dome) cast nothing.
+// shorter than the lamp's penumbra centred on the cap; cast from the cap, the floor's
+// direct light is closer to the path tracer's in kiln-bench-quality. Casters within
+// kLightNear below that point or above it (a marble by the dome) cast nothing.
 // 140° field of view: the floor and every caster are inside; the walls' upper parts
 // (above about half a metre below the eye, receivers only, already shaded by the
 // lamp's directional falloff) fall outside and read as lit.
@@ -60,10 +59,9 @@ float shadowHard(sampler2D shadowMap, vec3 p, float bias) {
 // about k+1 texels wide (5 → 9 over 6×6 texels, where a nearest-texel 5×5 box needs 25).
 // The blends are whole texels apart, so they share their bilinear weights: each
 // 2×2's four tests are gathered (textureGather on the comparison sampler), summed by
-// their place in it, and blended once — the same filter to the last bit of `hdr` at
-// 256² (one texel of `direct` one half-float step off), and composite 0.66 ms cheaper
-// at 720² with 50 fireballs recomputing every pixel (0.1 with two; seven alternations):
-// llvmpipe's filtered lookup weighs its four tests itself, four times over.
+// their place in it, and blended once — the same filter (to rounding in `direct`), and
+// a cheaper composite where many pixels are recomputed: llvmpipe's filtered lookup
+// weighs its four tests itself, four times over.
 // Unrolled: the kernel is a compile-time constant (on llvmpipe a loop with a uniform
 // bound, and a branch around taps, cost more than the taps). Outside the light's
 // frustum: lit.

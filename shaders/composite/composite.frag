@@ -199,8 +199,8 @@ vec3 shade(ivec2 px, vec2 uv, vec3 lampLit, vec3 albedo) {
     return emission.a > 1.5 ? emission.rgb : direct + indirect + emission.rgb;
 }
 
-// The lamp light as `direct` keeps it (RGBA16F: an RGBA32F fetch cost llvmpipe 3.5 ms at
-// 720², a half one about 2): rounded to halves, below the smallest normal half taken
+// The lamp light as `direct` keeps it (RGBA16F: an RGBA32F fetch is dearer on llvmpipe
+// than a half one): rounded to halves, below the smallest normal half taken
 // as 0 (a render target may flush what packHalf2x16 keeps). Every variant shades from
 // it so, whether it computed the light or read it back: the picture is the same
 // with keep_direct on or off (the hdr output is halves too).

@@ -18,7 +18,7 @@ layout(std430, binding = 1) buffer PreviousInstances { KilnInstance previous[]; 
 layout(std430, binding = 2) buffer TileMarks { uint tileMarks[]; };
 // The boxes of the moved casters' shadow pyramids, for the receivers' pass to test
 // (composite.cpp zeroes the count): a loop over every instance in each caster's
-// invocation cost 4 ms with 4 000 particles.
+// invocation is dear with thousands of particles.
 layout(std430, binding = 4) buffer ShadowPyramids { uint pyramidCount; vec4 pyramidBoxes[]; };
 // KILN_PART 0: the shadow casters (tumblers, marbles), 1: the other instances (a
 // caster's pyramid in the same program cost every invocation on llvmpipe, which runs

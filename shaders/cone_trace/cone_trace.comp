@@ -101,7 +101,7 @@ void main() {
     for (int k = trace ? 0 : 1; k < 1; ++k) {
 #else
     vec4 indirect;
-    {  // every sample traced (a loop around it, even a constant one, cost 2 ms at 720²)
+    {  // every sample traced (a loop around it, even a constant one, cost more)
 #endif
         indirect = traceDiffuse(p, n);
 #if KILN_LAMP_IN_ALPHA

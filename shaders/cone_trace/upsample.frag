@@ -9,7 +9,7 @@
 // the four.
 // No wider search for those few pixels: llvmpipe runs both sides of a divergent
 // branch under lane masks, so a fallback that almost never runs still costs every
-// pixel its taps (a 3×3 search measured +9 ms at 720², for a handful of pixels).
+// pixel its taps (a 3×3 search cost far more than the handful of pixels it served).
 #include "common/frame.glsl"
 #include "upsample.glsl"
 
@@ -47,7 +47,7 @@ void main() {
     ivec2 h0 = ivec2(floor(u));
     vec2 f = u - vec2(h0);
     // The nearest sample, round(u), is tap h0 + (round(u) − h0), an offset of 0 or 1: no
-    // fetch of its own (0.3 ms at 720²).
+    // fetch of its own.
     ivec2 nearestOffset = ivec2(round(u)) - h0;
     int nearestTap = nearestOffset.x + 2 * nearestOffset.y;
     vec4 sum = vec4(0.0), nearest = vec4(0.0);

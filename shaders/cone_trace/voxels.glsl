@@ -16,8 +16,8 @@
 // an open face (the Cornell box's front) has nothing behind it. Clamping alone stretched
 // the open front's rims — the floor's, the ceiling's and the side walls' last voxels —
 // into a tunnel in front of the box: every cone that left by the front met it, and the
-// gathered light was 1.26× the path tracer's in a box of emitting walls (1.24× for the
-// lamp's first bounce; tests/gi/test_bounces.cpp).
+// gathered light came out well above the path tracer's, in a box of emitting walls and
+// for the lamp's first bounce alike (tests/gi/test_bounces.cpp).
 #include "common/frame.glsl"
 layout(binding = 2) uniform sampler3D u_voxels;
 layout(binding = 3) uniform sampler3D u_aniso;

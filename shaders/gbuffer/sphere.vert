@@ -2,8 +2,8 @@
 // Spheres (marbles, fireballs) traced, not tessellated: each one the screen rectangle
 // its sphere projects into (two triangles, six vertices, instances [u_first, u_first +
 // count) of the scene's instance buffer), sphere.frag intersecting each pixel's ray with
-// it. llvmpipe sets up every triangle on the CPU: fifty fireballs' 16 × 8 meshes cost the
-// G-buffer 2 ms at 720², and their silhouettes are polygons.
+// it. llvmpipe sets up every triangle on the CPU, so many fireballs' 16 × 8 meshes are
+// dear there, and their silhouettes are polygons.
 #include "common/frame.glsl"
 #include "common/instances.glsl"
 

@@ -14,7 +14,7 @@ layout(binding = 2) uniform sampler3D u_normal;                // voxelize.norma
 // blended from the six values here: for each direction d, the three facing it weighted
 // by d² (a lookup into it equals the three-lookup blend cone_trace/voxels.glsl does
 // otherwise: trilinear filtering is linear). In the same dispatch: a dispatch of its own
-// reloaded the six and cost llvmpipe about 50 µs a level before any work.
+// reloaded the six and cost llvmpipe time at every level before any work.
 #include "common/fixed_cones.glsl"
 layout(rgba16f, binding = 3) uniform writeonly image3D u_fixed;  // kFixedConeTiles tiles of side u_size along x
 #endif

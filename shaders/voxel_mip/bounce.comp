@@ -21,7 +21,7 @@
 // 1 with KILN_GATHER_LIST then runs over the list only: llvmpipe runs a compute shader's
 // loop for all 8 lanes of a SIMD vector while any one has work, and every row of 8 blocks
 // meets a side wall, so over the whole grid every block paid a surface's cones. (The
-// list was a dispatch of its own, which read the same voxels again: 0.3 ms at 720².)
+// list was a dispatch of its own, which read the same voxels again.)
 // fixed_cones.glsl first: trace.glsl's voxels.glsl includes it only inside
 // `#if KILN_HAS_FIXED_CONES`, and a file is included once per stage.
 #include "common/fixed_cones.glsl"

@@ -1,8 +1,8 @@
 #version 450 core
 // One level of voxelize.fire's mips: each texel the mean of the 2×2×2 below it (the
 // particles' optical depth across a level-0 voxel, averaged: what a cone as wide as the
-// texel sees). A compute pass, not glGenerateTextureMipmap: NVIDIA's driver took 0.7 ms
-// of GPU time and up to 7 ms of the CPU's for it on this 32³ R16F volume.
+// texel sees). A compute pass, not glGenerateTextureMipmap: NVIDIA's driver spent GPU
+// time and far more CPU time on it for this 32³ R16F volume.
 layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
 
 layout(r16f, binding = 0) uniform readonly image3D u_finer;

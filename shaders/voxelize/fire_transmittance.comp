@@ -2,9 +2,9 @@
 // fire_cover: `lamp_transmittance`, the fraction of the lamp each node of a grid of
 // voxelize's transmittance_resolution³ sees past the fire (common/fire.glsl: the fireballs exactly, the
 // particles through `fire`), facing the lamp. resolve.comp takes each voxel's lamp light
-// through it and cone_trace each traced pixel's: one lookup where a march per voxel cost
-// voxelize 7 -> 13 ms at 720² on llvmpipe. The lamp is large, so the fraction changes
-// slowly away from the fire.
+// through it and cone_trace each traced pixel's: one lookup where a march per voxel
+// would cost far more. The lamp is large, so the fraction changes slowly away from the
+// fire.
 layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
 
 #include "common/frame.glsl"
@@ -18,8 +18,8 @@ uniform int u_firstFireball, u_fireballCount;
 // The fireballs that may hide part of the lamp from some node of this workgroup's 4³
 // block: those within the capsule from the block's centre to the lamp's, as thick as the
 // larger of the block's and the lamp's bounding spheres (the hull of every segment from
-// the block to the lamp lies inside it). With 50 fireballs, every node testing every one
-// cost 3 ms on llvmpipe.
+// the block to the lamp lies inside it): every node testing every fireball is dear on
+// llvmpipe with many of them.
 shared vec4 s_fireballs[kFireMaxFireballs];
 shared uint s_count;
 int fireballCount() { return int(s_count); }

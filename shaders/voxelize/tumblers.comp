@@ -83,8 +83,8 @@ void main() {
     uvec3 lit = toFixedRadiance(lampReflected(inst.albedo.rgb, surface, n));
     // One fragment, as splat.comp adds a sphere. Counted as several (the low-poly mesh
     // left one per triangle over a voxel, up to 12 around a pole), it weighs more where
-    // a tumbler shares a voxel with the floor: six brought relMSE at 256², t = 0 from
-    // 0.0124 to 0.0115 (the mesh 0.0114) but at 128², t = 0.5 from 0.0128 to 0.0138
-    // (the mesh 0.0125). Not a weight to tune, then; the difference stays open.
+    // a tumbler shares a voxel with the floor: a heavier weight brought one frame of the
+    // quality bench closer to the mesh and took another further from it. Not a weight
+    // to tune, then; the difference stays open.
     addSurfaceToVoxel(v, lit, toFixedRadiance(inst.emissive.rgb), inst.albedo.rgb, n);
 }

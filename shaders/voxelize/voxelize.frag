@@ -35,7 +35,7 @@ void main() {
     // taken before the discard below, while the whole 2x2 quad still runs. After it the
     // derivative is undefined - llvmpipe only masks a discarded lane and still gave the
     // right span, NVIDIA's driver does not, and its tumblers' shells lost voxels where
-    // their surfaces turn steep (the indirect light under them was 1.8x llvmpipe's).
+    // their surfaces turn steep (the indirect light under them far brighter than llvmpipe's).
     vec3 q = kilnWorldToVolume(v_world);
     float depth = v_axis == 0 ? q.x : v_axis == 1 ? q.y : q.z;
     float span = 0.5 * (abs(dFdx(depth)) + abs(dFdy(depth)));

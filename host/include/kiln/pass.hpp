@@ -164,17 +164,17 @@
 //   Where there is no GPU (CI, Mesa's llvmpipe) a shader runs 8 pixels or invocations
 //   at a time, and an `if`, a `?:` or a loop body runs for all 8 whichever way they go:
 //   a branch on a uniform or on the data saves nothing, and a lookup behind it is paid
-//   everywhere (a procedural material's lookup behind `if`: a third of a G-buffer's
-//   time at 720²). Choose what runs with defines (ctx.program's .defines, one variant per case)
-//   or by drawing each variant over only what needs it, not with branches. Each texture
-//   lookup costs about a millisecond at 720²: a pass gets cheaper by fewer lookups a
-//   pixel, not by cheaper arithmetic — and by narrower texels: an RGBA32F fetch cost
-//   3.5 ms where an RGBA16F one cost about 2. `discard` saves nothing (the rest of the
-//   shader runs), nor does a depth test that fails everywhere (a full-screen pass
-//   masked so still cost 2–3 ms). To draw part of the picture, draw only that part,
-//   in squares aligned to llvmpipe's 64-pixel tiles: it sets up every triangle again in
-//   each tile it touches (composite over 16-pixel squares: +3 to +5 ms). Measure with
-//   kiln-bench-render.
+//   everywhere (a procedural material's lookup behind `if` is paid by every pixel of a
+//   G-buffer). Choose what runs with defines (ctx.program's .defines, one variant per case)
+//   or by drawing each variant over only what needs it, not with branches. Texture
+//   lookups are the cost: a pass gets cheaper by fewer lookups a pixel, not by cheaper
+//   arithmetic — and by narrower texels: an RGBA32F fetch costs more than an RGBA16F
+//   one. `discard` saves nothing (the rest of the shader runs), nor does a depth test
+//   that fails everywhere (a full-screen pass masked so is still far from free). To
+//   draw part of the picture, draw only that part, in squares aligned to
+//   llvmpipe's 64-pixel tiles: it sets up every triangle again in each tile it touches
+//   (smaller squares cost more). Measure with kiln-bench-render; the figures are in
+//   docs/performance.md.
 //
 // GL STATE
 //   Before each pass the host resets: framebuffer 0 and the viewport to the output
