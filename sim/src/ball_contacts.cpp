@@ -32,6 +32,14 @@ bool bounceOffLamp(const Scene::Lamp& lamp, double e, double gy, double dt, cons
 
 }  // namespace
 
+// physics.balls_keep_speed: the ball leaves at the speed it came, as the course design's
+// reflection has it, so the balls keep their energy; the tumbler takes the impulse all
+// the same (energy friction then takes out of the tumblers).
+void World::keepSpeed(Vec3& u, double speed) const {
+    const double now = glm::length(u);
+    if (scene_.physics.ballsKeepSpeed && now > 1e-12) u *= speed / now;
+}
+
 void World::bounceOffTumblers(int bi, double gy, double dt, Vec3& v0) {
     // The tumblers as time-symmetric bounces too: if the step from x₀ would end inside a
     // tumbler (already moved this sub-step), the hit happens at the start instead, on the
@@ -55,7 +63,9 @@ void World::bounceOffTumblers(int bi, double gy, double dt, Vec3& v0) {
         if (vn >= 0.0) continue;  // separating at the start: a graze, the push handles it
         const double k = 1.0 / ball.mass() + rollingInverseMass(i, h, n);
         const double jn = -(1.0 + scene_.physics.restitution.ballTumbler) * vn / k;
+        const double speed = glm::length(u);
         u += (jn / ball.mass()) * n;
+        keepSpeed(u, speed);
         applyRollingImpulse(i, h, -jn * n);
         wake(i);
         v0 = u - Vec3(0, 0.5 * gy * dt, 0);
@@ -176,7 +186,9 @@ bool World::resolveBallTumblerContact(int bi, int i) {
     // with e = 1 the kinetic energy of ball + tumbler is kept.
     const double k = 1.0 / ball.mass() + rollingInverseMass(i, h, n);
     const double jn = -(1.0 + scene_.physics.restitution.ballTumbler) * vn / k;
-    ball.velocity += (jn / ball.mass()) * n;
+    Vec3 after = u + (jn / ball.mass()) * n;
+    keepSpeed(after, glm::length(u));
+    ball.velocity = after + Vec3(0, 0.5 * g * substepDt_, 0);
     applyRollingImpulse(i, h, -jn * n);
     wake(i);
     if (ball.kind == BallKind::Fireball) emitSparks(h, n, 10);

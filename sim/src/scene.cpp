@@ -332,7 +332,7 @@ bool readPhysics(const Json& root, Scene& s, SceneError& error) {
         if (!r.number("dt", s.physics.dt, 1e-5, 0.1) || !r.integer("substeps", s.physics.substeps, 1, 64) ||
             !r.integer("max_substeps", s.physics.maxSubsteps, 1, 4096) ||
             !r.number("gravity", s.physics.gravity, 0, 100) || !r.number("friction", s.physics.friction, 0, 10) ||
-            !r.number("wall_decay", s.physics.wallDecay, 0, 1) ||
+            !r.number("wall_decay", s.physics.wallDecay, 0, 1) || !r.boolean("balls_keep_speed", s.physics.ballsKeepSpeed) ||
             !r.choice("tumbler_mode", {"course", "accurate"}, mode) ||
             !r.choice("tumbler_contact", {"four_spheres", "exact"}, contact) ||
             !r.number("ballast_h", s.physics.ballastH, -0.19, 0.19) || !r.number("seed", seed, 0, 4294967295.0) || !r.finish())

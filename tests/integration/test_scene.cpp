@@ -188,10 +188,12 @@ TEST_CASE("the shadow pass is skipped while no caster moves and runs when one do
     rig.app.frame();
     CHECK(rig.stateOf("gbuffer") == "ran");
     CHECK(rig.stateOf("shadow") == "skipped");
-    // Dragging a tumbler moves a caster: the map is redrawn.
+    // Dragging a tumbler moves a caster: the map is redrawn. Held below its centre of
+    // mass (ballast_h under the lower sphere's centre), it slides.
     auto& sim = rig.app.scene().sim();
     const sim::Vec3 p = sim.tumblers()[2].position;
-    auto hit = sim.raycastTumblers(p + sim::Vec3(0, -0.1, 2.0), sim::Vec3(0, 0, -1));
+    const double below = rig.app.scene().sim().scene().physics.ballastH + 0.05;
+    auto hit = sim.raycastTumblers(p + sim::Vec3(0, -below, 2.0), sim::Vec3(0, 0, -1));
     REQUIRE(hit);
     REQUIRE(sim.beginDrag(*hit) == sim::DragMode::Translate);
     sim.dragTo(hit->point + sim::Vec3(0.1, 1.0, 0.0), sim::Vec3(0, -1, 0));

@@ -24,4 +24,13 @@ inline Scene shippedScene() {
     return s;
 }
 
+// The shipped scene's bodies with every contact elastic and no friction: what keeps its
+// energy exactly, for the conservation tests (the shipped scene damps its tumblers).
+inline Scene energyKeepingScene() {
+    Scene s;
+    std::string error;
+    REQUIRE(loadScene(std::string(KILN_SOURCE_DIR) + "/tests/sim/data/energy_keeping.json", s, error));
+    return s;
+}
+
 }  // namespace kiln::sim::test

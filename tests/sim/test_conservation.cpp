@@ -108,8 +108,8 @@ TEST_CASE("the lamp bounce keeps a marble's modified energy exactly", "[sim][con
     CHECK(worst < 1e-10);
 }
 
-TEST_CASE("the shipped scene keeps its energy for 10 simulated minutes", "[sim][conservation]") {
-    // scenes/cornell.json as shipped: every contact elastic, no rolling friction. Balls
+TEST_CASE("the energy-keeping box keeps its energy for 10 simulated minutes", "[sim][conservation]") {
+    // tests/sim/data/energy_keeping.json: every contact elastic, no rolling friction. Balls
     // and tumblers trade energy at every hit (a tumbler is as heavy as a marble), so the
     // balls' share swings; what must hold is the total, balls (modified energy E′) +
     // tumblers (½ωᵀAω + m·g·G_y) + what burnt marbles took with them. Bound: 1e-4 of
@@ -118,7 +118,7 @@ TEST_CASE("the shipped scene keeps its energy for 10 simulated minutes", "[sim][
     // the rare corrections that cannot be paid for (a ball too slow to pay for being
     // lifted out of a tumbler).
     // Every frame: nothing outside the box, no ball centre inside a tumbler.
-    Scene s = shippedScene();
+    Scene s = energyKeepingScene();
     REQUIRE(s.physics.friction == 0.0);
     World w(s);
     double kinetic0 = 0.0;
@@ -225,7 +225,7 @@ TEST_CASE("large steps: every sub-step option stays finite, contained and energy
         const int fixedCount = int(std::ceil(dt / kMaxFixedSubstep - 1e-9));
         for (const Option& o : {Option{"adaptive from 1", 1, 256}, Option{"adaptive from 4", 4, 256},
                                 Option{"fixed at the bound", fixedCount, fixedCount}}) {
-            Scene s = shippedScene();
+            Scene s = energyKeepingScene();
             s.fireballs.clear();
             s.physics.dt = dt;
             s.physics.substeps = o.substeps;

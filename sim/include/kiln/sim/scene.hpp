@@ -25,6 +25,9 @@
 //       "gravity": 9.81,            // m/s², [0, 100]
 //       "friction": 0.005,          // μ of the rocking damping (docs/physics.md §3), [0, 10]
 //       "wall_decay": 0.5,          // tumbler velocity kept after hitting a wall, [0, 1]
+//       "balls_keep_speed": false,  // a ball leaves a tumbler at the speed it came (the
+//                                   //   tumbler still takes the impulse): the balls keep
+//                                   //   their energy while friction damps the tumblers
 //       "tumbler_mode": "course" | "accurate",         // restoring impulse | weighted base
 //       "tumbler_contact": "four_spheres" | "exact", // tumbler-vs-tumbler method
 //       "ballast_h": 0.05,          // accurate mode: centre of mass this far below O
@@ -120,6 +123,7 @@ struct Scene {
         double gravity = 9.81;
         double friction = 0.005;    // μ of the rocking/rolling damping (decel. μg/b rad/s²)
         double wallDecay = 0.5;     // tumbler-wall restitution: normal velocity kept after a hit
+        bool ballsKeepSpeed = false;  // a ball's speed relative to the box is kept through a tumbler hit
         TumblerMode tumblerMode = TumblerMode::Accurate;
         TumblerContact tumblerContact = TumblerContact::Exact;
         double ballastH = 0.05;     // accurate mode: centre of mass this far below O (negative:

@@ -246,6 +246,7 @@ private:
     bool separateBallsFromTumblers();
     void settleTumblers();
     void stepBall(int ball, double dt);
+    void keepSpeed(Vec3& midStepVelocity, double speed) const;
     void bounceOffTumblers(int ball, double gy, double dt, Vec3& v0);
     void moveBallKeepingEnergy(Ball& ball, const Vec3& to);
     void collideBallTumblers(int ball);
