@@ -545,10 +545,12 @@ bool measureAll(app::App& app, const Args& args, const std::vector<Setting>& set
     results.assign(settings.size(), Result{});
     std::vector<std::map<std::string, std::vector<double>>> passSamples(settings.size());
     std::vector<std::vector<double>> totals(settings.size());
+    cli::Progress progress("settings measured", args.repeats * int(settings.size()));
     for (int round = 0; round < args.repeats; ++round)
         for (size_t i = 0; i < settings.size(); ++i) {
             Result r;
             if (!measure(app, args, settings[i], ref, r)) return false;
+            progress.advance(round * int(settings.size()) + int(i) + 1);
             totals[i].push_back(r.totalMs);
             for (auto& [id, ms] : r.passMs) passSamples[i][id].push_back(ms);
             if (round == 0) results[i] = std::move(r);

@@ -383,13 +383,16 @@ int main(int argc, char** argv) {
         }
     std::vector<Measured> measured(configs.size());
     std::vector<double> floors;  // per round, measured beside the configurations
+    cli::Progress progress("pipelines timed", args.repeats * int(configs.size()));
     for (int round = 0; round < args.repeats; ++round) {
         floors.push_back(emptyPassMs(args.width, args.height, std::max(args.frames, 20)));
-        for (size_t i = 0; i < configs.size(); ++i)
+        for (size_t i = 0; i < configs.size(); ++i) {
             if (!measureRound(args, configs[i], texts[i], measured[i], error)) {
                 std::fprintf(stderr, "kiln-bench-render: error: %s: %s\n", configs[i].pipeline.c_str(), error.c_str());
                 return 1;
             }
+            progress.advance(round * int(configs.size()) + int(i) + 1);
+        }
     }
     const double floorMs = median(floors);
     std::printf("floor: an empty full-screen pass at %dx%d (its coordinates written to RGBA16F) takes %.3f ms (wall, glFinish)\n\n",
