@@ -15,13 +15,23 @@
 
 namespace fs = std::filesystem;
 
-TEST_CASE("the installed SDK headers name no object of the demo scene", "[sdk]") {
-    const fs::path prefix = fs::path(TEST_OUTPUT_DIR) / ("names-" + std::to_string(getpid()));
+namespace {
+
+// This build installed into a prefix of its own (the test's earlier ones removed).
+fs::path installedSdk(const std::string& name) {
+    const fs::path prefix = fs::path(TEST_OUTPUT_DIR) / (name + "-" + std::to_string(getpid()));
     kiln::test::removeEarlierRuns(prefix);
     auto install = kiln::test::runProgram(CMAKE_COMMAND, "--install '" + std::string(KILN_BUILD_DIR) + "' --prefix '" +
                                                              prefix.string() + "'", 600);
     INFO(install.out << install.err);
     REQUIRE(install.exitCode == 0);
+    return prefix;
+}
+
+}  // namespace
+
+TEST_CASE("the installed SDK headers name no object of the demo scene", "[sdk]") {
+    const fs::path prefix = installedSdk("names");
     // The Cornell box's objects and their materials; "wall" and "sphere" are any scene's.
     const std::regex demo(R"(\b(cornell|tumblers?|roly-poly|marbles?|fireballs?|wood|lamps?|domes?|the box)\b)",
                           std::regex::icase);
@@ -45,12 +55,7 @@ TEST_CASE("the installed SDK headers name no object of the demo scene", "[sdk]")
 }
 
 TEST_CASE("the SDK is one directory: what installs is what an in-tree pass can include", "[sdk]") {
-    const fs::path prefix = fs::path(TEST_OUTPUT_DIR) / ("sdk-list-" + std::to_string(getpid()));
-    kiln::test::removeEarlierRuns(prefix);
-    auto install = kiln::test::runProgram(CMAKE_COMMAND, "--install '" + std::string(KILN_BUILD_DIR) + "' --prefix '" +
-                                                             prefix.string() + "'", 600);
-    INFO(install.out << install.err);
-    REQUIRE(install.exitCode == 0);
+    const fs::path prefix = installedSdk("sdk-list");
     auto headersIn = [](const fs::path& dir) {
         std::set<std::string> names;
         for (const fs::directory_entry& e : fs::directory_iterator(dir))
