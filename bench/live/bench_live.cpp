@@ -55,7 +55,7 @@ int main(int argc, char** argv) {
     std::string outDir = "bench-out";
     CLI::App app{"kiln-bench-live — save to new pixels, headless at 720x720: a shader edit, a pipeline edit and a\n"
                  "module swap, each timed from the file's write to the first frame that shows it (median and\n"
-                 "max). About 15 s with 20 trials. Writes OUT/live.csv.",
+                 "max), a few seconds with 20 trials. Writes OUT/live.csv.",
                  "kiln-bench-live"};
     cli::configure(app);
     app.add_option("--trials", trials, "edits of each kind (default 20)")->type_name("N")->check(CLI::Range(2, 10000));
