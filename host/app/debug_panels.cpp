@@ -4,6 +4,7 @@
 // sync). The windows about the image are inspectors.cpp.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string_view>
@@ -173,11 +174,22 @@ void pipelineSwitcher(WindowState& state, float width) {
 
 GLuint imageTextureFor(const App& app, const WindowState& state, run::NamedTexture& named);
 
+// The next item beside the last when it fits whole in the column, else on the next line
+// (a long frame-time line cut "save image" to "save i").
+void sameLineIfFits(float width) {
+    const ImGuiStyle& style = ImGui::GetStyle();
+    const float right = ImGui::GetItemRectMax().x + style.ItemSpacing.x + width;
+    if (right <= ImGui::GetWindowPos().x + ImGui::GetWindowContentRegionMax().x) ImGui::SameLine();
+}
+
+float buttonWidth(const char* label) {
+    return ImGui::CalcTextSize(label).x + ImGui::GetStyle().FramePadding.x * 2;
+}
+
 // The pipeline switcher and the graph and compare toggles on one line, the switcher taking
 // what the buttons leave (it was given a fixed share, and cut the last button off).
 void headerRow(WindowState& state) {
     const ImGuiStyle& style = ImGui::GetStyle();
-    auto buttonWidth = [&](const char* label) { return ImGui::CalcTextSize(label).x + style.FramePadding.x * 2; };
     const float buttons = buttonWidth("graph") + buttonWidth("compare") + style.ItemSpacing.x * 2;
     pipelineSwitcher(state, std::max(80.0f, ImGui::GetContentRegionAvail().x - buttons));
     ImGui::SameLine();
@@ -196,7 +208,7 @@ void frameLine(WindowState& state) {
                 app.runtime().outputTexture() ? app.runtime().outputTexture()->height : 0);
     state.probe.item("frame-line");
     // What the image shows, as its texture holds it: no error overlay, no panels.
-    ImGui::SameLine();
+    sameLineIfFits(buttonWidth("save image"));
     if (ImGui::SmallButton("save image")) {
         run::NamedTexture shown;
         if (imageTextureFor(app, state, shown)) {
@@ -205,8 +217,10 @@ void frameLine(WindowState& state) {
     }
     state.probe.item("save-image");
     if (state.renderScale < 1.0f) {
-        ImGui::SameLine();
-        ImGui::TextColored(ImVec4(1.0f, 0.75f, 0.3f, 1.0f), "(scale %.2f)", state.renderScale);
+        char scale[32];
+        std::snprintf(scale, sizeof scale, "(scale %.2f)", state.renderScale);
+        sameLineIfFits(ImGui::CalcTextSize(scale).x);
+        ImGui::TextColored(ImVec4(1.0f, 0.75f, 0.3f, 1.0f), "%s", scale);
     }
 }
 

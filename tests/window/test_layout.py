@@ -98,7 +98,7 @@ def check_size(size, window_w, window_h):
         widgets = p["widgets"]
         sidebar = [0, 0, SIDEBAR, window_h]
         rows = [k for k in widgets if k.split(":")[0] in ("pipeline-switcher", "show-graph", "show-compare", "frame-line",
-                                                           "pass-enabled", "pass", "tab")]
+                                                           "save-image", "pass-enabled", "pass", "tab")]
         cut = [k for k in rows if not inside(widgets[k], sidebar)]
         check(len(rows) >= 20 and not cut, "%s: all %d sidebar widgets inside the sidebar (cut: %s)" % (name, len(rows), cut))
         check(all(k in widgets for k in ("show-compare", "frame-line", "tab:Scene")),
