@@ -86,7 +86,7 @@ std::string checkCombination(const CLI::App& app, const Options& o) {
         return "--watch keeps a headless run going and rewrites its files after each live edit: it needs --headless "
                "and --out or --dump, and not --no-live";
     if (o.headless) {
-        for (const char* windowOnly : {"--screenshot", "--ui-probe", "--budget"})
+        for (const char* windowOnly : {"--window", "--screenshot", "--ui-probe", "--budget"})
             if (given(windowOnly))
                 return std::string(windowOnly) + " is for the window; a headless run writes --out, --dump or --stats";
         if (o.out.empty() && o.dump.empty() && !o.stats && !o.printPlan && o.dot.empty())
@@ -144,6 +144,8 @@ std::variant<Options, int> parseCommandLine(int argc, char** argv) {
     app.add_flag("--watch", o.watch, "rewrite --out and --dump after each live edit, until Ctrl+C")->group(headless);
 
     const char* window = "Window";
+    cli::addSize(app, "--window", o.windowWidth, o.windowHeight, 64, 16384,
+                 "the window's size (default: --size plus the panels' column)")->group(window);
     app.add_option("--screenshot", o.screenshot, "save the window after --frames frames, then quit")
         ->type_name("FILE.png")->group(window);
     app.add_option("--budget", o.budgetMs, "lower the resolution while frames take > MS (default 100; 0: off)")

@@ -18,6 +18,7 @@ struct Options {
     std::string moduleDir;    // ':'-separated; an empty entry: the shipped modules
     bool headless = false;
     int width = 720, height = 720;
+    int windowWidth = 0, windowHeight = 0;  // --window; 0: --size plus the panels' column
     int frames = 1;           // frames rendered before the outputs (then the GI settles)
     std::string out;          // the final image: PNG, OpenEXR or PFM by its extension
     std::string dump;         // directory for every texture of the last frame

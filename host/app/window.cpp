@@ -194,8 +194,11 @@ void drawUi(WindowState& state, int fbW, int fbH) {
 
 int runWindow(const Options& o) {
     std::string error;
-    // The panels get a column of their own beside an image of --size.
-    auto context = WindowContext::create(o.width + kSidebarWidth, o.height, "Kiln", true, error);
+    // By default the panels get a column of their own beside an image of --size; the
+    // image then takes the room the window leaves it, at --size's aspect.
+    const int windowWidth = o.windowWidth ? o.windowWidth : o.width + kSidebarWidth;
+    const int windowHeight = o.windowHeight ? o.windowHeight : o.height;
+    auto context = WindowContext::create(windowWidth, windowHeight, "Kiln", true, error);
     if (!context) {
         std::fprintf(stderr, "kiln: error: %s; without a display use --headless (or run under xvfb-run)\n", error.c_str());
         return 1;

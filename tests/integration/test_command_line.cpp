@@ -95,6 +95,7 @@ TEST_CASE("kiln refuses what would do nothing or write the wrong thing, before i
         {"--headless --size 16x16 --out " + (dir / "x").string(), "the format follows the extension", 2},
         {"--headless --size 16x16 --out " + out + " --screenshot s.png", "--screenshot is for the window", 2},
         {"--headless --size 16x16 --out " + out + " --budget 50", "--budget is for the window", 2},
+        {"--headless --size 16x16 --out " + out + " --window 800x600", "--window is for the window", 2},
         {"--size 16x16 --out " + out, "--out is for --headless", 2},
         {"--headless --size 16x16 --set shadow.size", "expected PASS.PARAM=VALUE", 2},
         {"--headless --size 16x16 --out " + out + " --view composite.colr", "did you mean \"color\"", 1},

@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """The debug view's layout at the sizes people run it: a 720-px-tall window (--size
-720x720, 1100x720 with the panels) and 1280x800 (--size 900x800). Nothing in the
+720x720, 1100x720 with the panels), 1280x800 (--size 900x800) and a 16:9 picture in a
+1280x800 window (--window). Nothing in the
 sidebar is cut off, the inspector windows (texture, pixel trace) sit beside the image
 and not over it, the image keeps its aspect, F1 gives it the whole window at that
 aspect, and the floating windows' places persist (ImGui's ini in $XDG_CONFIG_HOME).
@@ -34,7 +35,7 @@ def overlaps(a, b):
 
 
 class Window:
-    def __init__(self, size, name, fresh=True):
+    def __init__(self, size, name, fresh=True, window=None):
         self.dir = os.path.join(OUT, name)
         shutil.rmtree(self.dir, ignore_errors=True)
         os.makedirs(self.dir)
@@ -43,7 +44,7 @@ class Window:
         if fresh:  # the first-run layout, whatever an earlier run left
             shutil.rmtree(self.config, ignore_errors=True)
         self.kiln = subprocess.Popen([KILN, "--paused", "--size", size, "--budget", "0", "--view", "gbuffer.normal",
-                                      "--ui-probe", self.probe_file],
+                                      "--ui-probe", self.probe_file] + (["--window", window] if window else []),
                                      env=dict(os.environ, XDG_CONFIG_HOME=self.config), cwd=self.dir,
                                      stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
         self.wait_for(lambda p: p["frame"] >= 3, "the first frames")
@@ -89,10 +90,10 @@ class Window:
             self.kiln.kill()
 
 
-def check_size(size, window_w, window_h):
-    name = "%dx%d" % (window_w, window_h)
+def check_size(size, window_w, window_h, window=None):
+    name = "%dx%d" % (window_w, window_h) + ("-window" if window else "")
     image_w, image_h = (int(v) for v in size.split("x"))
-    w = Window(size, name)
+    w = Window(size, name, window=window)
     try:
         p = w.frames_later()
         widgets = p["widgets"]
@@ -175,7 +176,7 @@ def check_size(size, window_w, window_h):
     ini = os.path.join(w.config, "kiln", "imgui.ini")
     check(os.path.exists(ini) and "[Window][Texture]" in open(ini).read() and "[Kiln][Floating]\nTexture" in open(ini).read(),
           "%s: window places, and that the texture window floats, are kept in %s" % (name, ini))
-    again = Window(size, name, fresh=False)
+    again = Window(size, name, fresh=False, window=window)
     try:
         p = again.frames_later()
         kept = p["widgets"].get("texture-window")
@@ -188,6 +189,8 @@ def check_size(size, window_w, window_h):
 try:
     check_size("720x720", 720 + SIDEBAR, 720)
     check_size("900x800", 900 + SIDEBAR, 800)
+    # --window sets the window apart from --size: a 16:9 picture in a 1280x800 window.
+    check_size("640x360", 1280, 800, window="1280x800")
 except RuntimeError as e:
     check(False, str(e))
 print("%d failure(s)" % len(failures))
