@@ -37,12 +37,12 @@ inline double median(std::vector<double> v) {
 }
 
 inline bool parseOverride(const std::string& text, Override& out, std::string& error) {
-    auto dot = text.find('.'), eq = text.find('=');
-    if (dot == std::string::npos || eq == std::string::npos || dot > eq) {
+    const std::optional<graph::ParamOverride> parsed = graph::parseParamOverride(text);
+    if (!parsed) {
         error = "\"" + text + "\": expected PASS.PARAM=VALUE";
         return false;
     }
-    out = {text.substr(0, dot), text.substr(dot + 1, eq - dot - 1), text.substr(eq + 1)};
+    out = {parsed->pass, parsed->param, parsed->value};
     return true;
 }
 

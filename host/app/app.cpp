@@ -30,18 +30,6 @@ void keepFreedHeap() {
     (void)done;
 }
 
-// "a:b::c" → a, b, c.
-std::vector<std::string> pathList(const std::string& list) {
-    std::vector<std::string> out;
-    for (size_t start = 0; start <= list.size();) {
-        size_t end = list.find(':', start);
-        if (end == std::string::npos) end = list.size();
-        if (end > start) out.push_back(list.substr(start, end - start));
-        start = end + 1;
-    }
-    return out;
-}
-
 }  // namespace
 
 bool App::init(const Options& o, std::string& error) {
@@ -77,10 +65,8 @@ bool App::init(const Options& o, std::string& error) {
     requested_ = requestedTextures();
     runtime_.setRequested(requested_);
     std::vector<Runtime::ParamOverride> overrides;
-    for (const std::string& set : o.sets) {  // PASS.PARAM=VALUE, checked when parsed
-        const size_t dot = set.find('.'), eq = set.find('=');
-        overrides.push_back({set, set.substr(0, dot), set.substr(dot + 1, eq - dot - 1), set.substr(eq + 1)});
-    }
+    for (const std::string& set : o.sets)
+        if (auto parsed = graph::parseParamOverride(set)) overrides.push_back(std::move(*parsed));  // checked when parsed
     runtime_.setOverrides(std::move(overrides));
     std::string errors;
     if (!runtime_.loadPipeline(o.pipeline, errors)) {

@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "command_line/command_line.hpp"
+#include "graph/pipeline.hpp"
 #include "kiln/data_root.hpp"
 
 namespace kiln::app {
@@ -54,6 +55,24 @@ std::string withShipped(const std::string& list, const std::string& shipped) {
 
 }  // namespace
 
+std::string imageFormatOf(const std::string& file) {
+    std::string ext = std::filesystem::path(file).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    for (const char* known : {".png", ".exr", ".pfm"})
+        if (ext == known) return ext.substr(1);
+    return "";
+}
+
+std::vector<std::string> pathList(const std::string& list) {
+    std::vector<std::string> out;
+    for (size_t start = 0; start <= list.size();) {
+        const size_t end = std::min(list.find(':', start), list.size());
+        if (end > start) out.push_back(list.substr(start, end - start));
+        start = end + 1;
+    }
+    return out;
+}
+
 void applyDefaults(Options& o) {
     const std::filesystem::path root = defaultDataRoot();
     if (o.pipeline.empty()) o.pipeline = (root / "pipelines/default.json").string();
@@ -64,23 +83,16 @@ void applyDefaults(Options& o) {
 
 namespace {
 
-bool hasExtension(const std::string& file, std::initializer_list<const char*> extensions) {
-    std::string ext = std::filesystem::path(file).extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-    return std::any_of(extensions.begin(), extensions.end(), [&](const char* e) { return ext == e; });
-}
 
 // The checks CLI11 cannot make: what a mode needs and which options it has no use for.
 // Each returns "" or the one line that explains the refusal.
 std::string checkCombination(const CLI::App& app, const Options& o) {
     auto given = [&](const char* name) { return app.count(name) > 0; };
     if (o.listModules || !o.describe.empty()) return "";
-    for (const std::string& set : o.sets) {
-        const size_t dot = set.find('.'), eq = set.find('=');
-        if (dot == std::string::npos || eq == std::string::npos || dot > eq || dot == 0 || eq == dot + 1)
+    for (const std::string& set : o.sets)
+        if (!graph::parseParamOverride(set))
             return "--set " + set + ": expected PASS.PARAM=VALUE (e.g. --set shadow.size=1024)";
-    }
-    if (!o.out.empty() && !hasExtension(o.out, {".png", ".exr", ".pfm"}))
+    if (!o.out.empty() && imageFormatOf(o.out).empty())
         return "--out " + o.out + ": the format follows the extension: .png (8 bits, display), .exr or .pfm (float)";
     if (o.watch && (!o.headless || !o.live || (o.out.empty() && o.dump.empty())))
         return "--watch keeps a headless run going and rewrites its files after each live edit: it needs --headless "
@@ -95,7 +107,7 @@ std::string checkCombination(const CLI::App& app, const Options& o) {
         for (const char* headlessOnly : {"--out", "--stats"})
             if (given(headlessOnly))
                 return std::string(headlessOnly) + " is for --headless; the window saves with --screenshot FILE";
-        if (!o.screenshot.empty() && !hasExtension(o.screenshot, {".png"}))
+        if (!o.screenshot.empty() && imageFormatOf(o.screenshot) != "png")
             return "--screenshot " + o.screenshot + ": a screenshot is a .png";
     }
     return "";

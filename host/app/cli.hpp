@@ -49,6 +49,11 @@ std::variant<Options, int> parseCommandLine(int argc, char** argv);
 // (pipelines/default.json and shaders/), else the shipped files (kiln/data_root.hpp:
 // the installation's, or the source tree's for a build-tree kiln).
 std::filesystem::path defaultDataRoot();
+// The image format a file's extension names, whatever its case: "png", "exr", "pfm",
+// or "" for any other (--out refuses those).
+std::string imageFormatOf(const std::string& file);
+// "a:b::c" → a, b, c (the empty entries dropped; applyDefaults has filled them).
+std::vector<std::string> pathList(const std::string& list);
 // Fills unset paths: pipelines/default.json and scenes/cornell.json under
 // defaultDataRoot(); its shaders/ and the shipped modules where the lists are empty or
 // have an empty entry.

@@ -1,11 +1,10 @@
 #include "app/describe.hpp"
 
 #include <cstdio>
-#include <sstream>
-#include <variant>
 
 #include "app/context.hpp"
 #include "command_line/command_line.hpp"
+#include "graph/plan.hpp"
 #include "kiln/log.hpp"
 #include "kiln/names.hpp"
 #include "run/module_registry.hpp"
@@ -13,34 +12,6 @@
 namespace kiln::app {
 
 namespace {
-
-std::vector<std::filesystem::path> moduleDirs(const Options& o) {
-    std::vector<std::filesystem::path> dirs;
-    std::istringstream list(o.moduleDir);
-    for (std::string dir; std::getline(list, dir, ':');)
-        if (!dir.empty()) dirs.emplace_back(dir);
-    return dirs;
-}
-
-std::string valueText(const ParamValue& v) {
-    return std::visit(
-        [](const auto& x) -> std::string {
-            using T = std::decay_t<decltype(x)>;
-            if constexpr (std::is_same_v<T, bool>) return x ? "true" : "false";
-            else if constexpr (std::is_same_v<T, int>) return std::to_string(x);
-            else if constexpr (std::is_same_v<T, float>) {
-                char b[32];
-                std::snprintf(b, sizeof b, "%g", double(x));
-                return b;
-            } else if constexpr (std::is_same_v<T, std::string>) return x;
-            else {
-                char b[96];
-                std::snprintf(b, sizeof b, "[%g, %g, %g]", double(x[0]), double(x[1]), double(x[2]));
-                return b;
-            }
-        },
-        v);
-}
 
 std::string number(double x) {
     char b[32];
@@ -125,7 +96,7 @@ std::string describe(const std::string& name, const PassDeclaration& d) {
     if (!d.params.empty()) {
         md += "\n| parameter | type | default | range | doc |\n|---|---|---|---|---|\n";
         for (const ParamDecl& p : d.params)
-            md += "| `" + p.name + "` | " + toString(p.type) + " | " + cell(valueText(p.def)) + " | " + cell(rangeText(p)) +
+            md += "| `" + p.name + "` | " + toString(p.type) + " | " + cell(graph::formatParamValue(p.def)) + " | " + cell(rangeText(p)) +
                   " | " + cell(p.doc) + " |\n";
     }
     return md;
@@ -146,7 +117,9 @@ std::optional<Probe> startProbe(const Options& o) {
         log::error(error);
         return std::nullopt;
     }
-    p.registry = std::make_unique<run::ModuleRegistry>(moduleDirs(o));
+    std::vector<std::filesystem::path> dirs;
+    for (const std::string& dir : pathList(o.moduleDir)) dirs.emplace_back(dir);
+    p.registry = std::make_unique<run::ModuleRegistry>(std::move(dirs));
     return p;
 }
 

@@ -31,10 +31,9 @@ int fail(const std::string& message) {
 
 // The final image in the format its extension names (checked when parsing).
 bool writeImage(const std::string& file, const FloatImage& img, std::string& error) {
-    std::string ext = fs::path(file).extension().string();
-    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
-    if (ext == ".exr") return writeExr(file, img, error);
-    if (ext == ".pfm") return writePfm(file, img, error);
+    const std::string format = imageFormatOf(file);
+    if (format == "exr") return writeExr(file, img, error);
+    if (format == "pfm") return writePfm(file, img, error);
     return writePng(file, img, 3, error);
 }
 

@@ -768,10 +768,7 @@ Result<Plan> compile(const PipelineDesc& desc, const CompileOptions& options) {
 Result<Plan> compileText(const std::string& text, const std::string& fileName, const CompileOptions& options) {
     Result<PipelineDesc> desc = parsePipeline(text, fileName);
     if (!desc) return Result<Plan>(desc.errors());
-    const PipelineReader read = [](const std::string& file, std::string& out, std::string& why) {
-        return json_text::readBoundedFile(file, kMaxPipelineFileBytes, "pipeline file", out, why);
-    };
-    Result<PipelineDesc> resolved = resolveExtends(std::move(*desc), read, nullptr, options.pipelineSearchDirs);
+    Result<PipelineDesc> resolved = resolveExtends(std::move(*desc), readPipelineFile, nullptr, options.pipelineSearchDirs);
     if (!resolved) return Result<Plan>(resolved.errors());
     return compile(*resolved, options);
 }

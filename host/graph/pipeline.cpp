@@ -96,6 +96,12 @@ ParamLiteral toLiteral(const Json& j) {
 
 }  // namespace
 
+std::optional<ParamOverride> parseParamOverride(const std::string& text) {
+    const size_t dot = text.find('.'), eq = text.find('=');
+    if (dot == std::string::npos || eq == std::string::npos || dot > eq || dot == 0 || eq == dot + 1) return std::nullopt;
+    return ParamOverride{text, text.substr(0, dot), text.substr(dot + 1, eq - dot - 1), text.substr(eq + 1)};
+}
+
 ParamLiteral parseParamLiteral(const std::string& value) {
     const Json j = Json::parse(value, nullptr, /*allow_exceptions=*/false);
     return toLiteral(j.is_discarded() ? Json(value) : j);

@@ -78,6 +78,13 @@ struct PassDesc {
 // A parameter value typed on a command line (--set PASS.PARAM=VALUE): VALUE as JSON
 // (1024, 0.5, true, [1, 0.5, 0.2], "text"), or a bare word as a string (an enum choice).
 ParamLiteral parseParamLiteral(const std::string& value);
+// "PASS.PARAM=VALUE" split at its first '.' and the first '=' after it (VALUE as typed,
+// for parseParamLiteral); nullopt when a part is missing or empty before the '='.
+struct ParamOverride {
+    std::string text;  // as typed, for messages
+    std::string pass, param, value;
+};
+std::optional<ParamOverride> parseParamOverride(const std::string& text);
 
 // Sets (or adds, at the end) the file's value of parameter `name`.
 void setParamLiteral(PassDesc&, const std::string& name, const ParamValue&);
@@ -115,6 +122,9 @@ Result<PipelineDesc> parsePipeline(const std::string& text, const std::string& f
 // the compiler's errors point there too.
 // The reader returns a file's text, or false and why not.
 using PipelineReader = std::function<bool(const std::string& file, std::string& text, std::string& why)>;
+// The one from disk: a pipeline file read whole within kMaxPipelineFileBytes, a device or
+// a directory refused by name (every pipeline file, extended ones too, is read so).
+bool readPipelineFile(const std::string& file, std::string& text, std::string& why);
 // `desc` as parsePipeline gave it; on success the whole pipeline, with `extends` cleared.
 // A relative "extends" is looked for beside the file, then in each of `searchDirs` (the
 // shipped pipelines/), as #include "..." is: "default.json" works from anywhere.

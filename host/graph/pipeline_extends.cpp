@@ -165,6 +165,10 @@ Result<PipelineDesc> resolve(PipelineDesc desc, const PipelineReader& read, std:
 
 }  // namespace
 
+bool readPipelineFile(const std::string& file, std::string& text, std::string& why) {
+    return json_text::readBoundedFile(file, kMaxPipelineFileBytes, "pipeline file", text, why);
+}
+
 Result<PipelineDesc> resolveExtends(PipelineDesc desc, const PipelineReader& read, std::vector<std::string>* chain,
                                     const std::vector<std::string>& searchDirs) {
     std::vector<std::string> files{fs::path(desc.fileName).lexically_normal().string()};

@@ -49,7 +49,7 @@ bool Runtime::init(const RuntimeOptions& options, std::string& error) {
 
 bool Runtime::loadPipeline(const fs::path& file, std::string& errors) {
     std::string text, why;
-    if (!json_text::readBoundedFile(file, graph::kMaxPipelineFileBytes, "pipeline file", text, why)) {
+    if (!graph::readPipelineFile(file.string(), text, why)) {
         errors = file.string() + ": " + why;
         return false;
     }
@@ -63,11 +63,8 @@ bool Runtime::loadPipelineText(const std::string& text, const std::string& displ
         return false;
     }
     // The files it extends are read relative to it, with the same bounds as the first.
-    const graph::PipelineReader read = [](const std::string& file, std::string& out, std::string& why) {
-        return json_text::readBoundedFile(file, graph::kMaxPipelineFileBytes, "pipeline file", out, why);
-    };
     std::vector<std::string> chain;
-    auto resolved = graph::resolveExtends(std::move(*parsed), read, &chain, options_.pipelineSearchDirs);
+    auto resolved = graph::resolveExtends(std::move(*parsed), graph::readPipelineFile, &chain, options_.pipelineSearchDirs);
     if (!resolved) {
         errors = resolved.errorText();
         return false;

@@ -64,10 +64,7 @@ public:
     // pipeline file loaded from then on, live reloads included. Each is checked as the
     // file's values are; an error names the --set, not a place in the file. They become
     // part of the running description, so the debug view's write-back writes them too.
-    struct ParamOverride {
-        std::string text;  // "PASS.PARAM=VALUE", as typed, for messages
-        std::string pass, param, value;
-    };
+    using ParamOverride = graph::ParamOverride;
     void setOverrides(std::vector<ParamOverride> overrides) { overrides_ = std::move(overrides); }
 
     // New output size; refused (textures unchanged, `error` says why) when the plan's
