@@ -13,6 +13,7 @@ packages=(
   libtinyexr-dev                     # OpenEXR read/write for HDR textures (--dump, reference cache)
   libtinygltf-dev                    # glTF 2.0 scenes (host/model)
   libmeshoptimizer-dev               # their meshes ordered for the vertex cache
+  libembree-dev                      # a CPU path tracer the reference is checked against (tests/)
   assimp-testmodels                  # glTF files made to break loaders, and valid ones (tests/model)
   openimageio-tools                  # idiff/oiiotool: the error metrics are cross-checked against them
   libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri libglx-mesa0   # EGL/GL + llvmpipe

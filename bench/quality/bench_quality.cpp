@@ -255,14 +255,24 @@ bool referenceHalf(app::App& app, const Args& args, int half, FloatImage& out, F
                              R"(, "seed": )" + std::to_string(seed) + "}}]}";
     if (!app.runtime().loadPipelineText(text, "reference", error)) return fail(error);
     const auto start = std::chrono::steady_clock::now();
-    for (int done = 0; done < paths; done += perFrame) {
+    // Until the first and the last row have every path: a frame stops at the pass's time
+    // budget, so how many frames that takes depends on the scene and the machine. (The
+    // first row is one pass ahead of the last while a pass is under way; until the last
+    // row is overwritten it may still hold the previous half's count.)
+    for (int now = 0; now < paths;) {
         app.frame();
-        glFinish();
+        const TextureRef* t = app.runtime().findTexture("reference", "radiance");
+        if (!t) return fail("the reference pass produced no texture");
+        float first[4] = {}, last[4] = {};
+        glGetTextureSubImage(t->id, 0, 0, 0, 0, 1, 1, 1, GL_RGBA, GL_FLOAT, sizeof first, first);
+        glGetTextureSubImage(t->id, 0, t->width - 1, t->height - 1, 0, 1, 1, 1, GL_RGBA, GL_FLOAT, sizeof last, last);
+        now = int(std::min(first[3], last[3]));
+        if (!app.runtime().activeErrors().empty()) return fail(app.runtime().activeErrors().front());
         const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        const int now = std::min(done + perFrame, paths);
         const int bar = 30 * now / paths;
         std::fprintf(stderr, "\r%s %dx%d [%-30s] %d/%d paths/px, %.0f s, ETA %.0f s ", what, args.width, args.height,
-                     std::string(size_t(bar), '#').c_str(), now, paths, elapsed, elapsed / now * (paths - now));
+                     std::string(size_t(bar), '#').c_str(), now, paths, elapsed,
+                     now > 0 ? elapsed / now * (paths - now) : 0.0);
     }
     std::fprintf(stderr, "\n");
     const TextureRef* t = app.runtime().findTexture("reference", "radiance");
@@ -275,7 +285,8 @@ bool referenceHalf(app::App& app, const Args& args, int half, FloatImage& out, F
     fs::create_directories(cache.parent_path());
     if (!writeExr(cache.string(), out, error) || !writeExr(directCache.string(), direct, error)) return fail(error);
     seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    std::printf("%s: %d paths/px in %.1f s, cached as %s\n", what, paths, seconds, cache.string().c_str());
+    std::printf("%s: %d paths/px in %.1f s (%.0f k paths/s), cached as %s\n", what, paths, seconds,
+                double(paths) * args.width * args.height / seconds / 1000.0, cache.string().c_str());
     return true;
 }
 

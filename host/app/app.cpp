@@ -157,6 +157,7 @@ SceneView App::buildView() {
     scene::packPunctualLights(scene_.lights(), scene_.boundsMin(), scene_.boundsMax(), v.frame);
     v.materialTextures[0] = renderer_.materialTexture(0);
     v.materialTextures[1] = renderer_.materialTexture(1);
+    v.rayMeshes = renderer_.rayMeshes();
 
     if (v.frame.viewProj != lastViewProj_) lastViewProj_ = v.frame.viewProj, ++cameraVersion_;
     lastVoxelVolume_ = v.frame.voxelVolume;

@@ -27,7 +27,8 @@ SceneLook lookOf(const sim::Scene& scene) {
     look.lampCentre = glm::vec3(scene.lamp.center);
     look.lampRadius = float(scene.lamp.radius);
     look.lampColor = glm::vec3(scene.lamp.color);
-    look.lampIntensity = scene.box.walls ? float(scene.lamp.intensity) : 0.0f;  // the lamp goes with the box
+    look.lamp = scene.box.lamp;
+    look.lampIntensity = scene.box.lamp ? float(scene.lamp.intensity) : 0.0f;
     look.tumblerB = float(scene.tumblerShape.b);
     look.tumblerT = float(scene.tumblerShape.t);
     look.tumblerAlpha = float(scene.tumblerShape.alpha);
@@ -128,6 +129,7 @@ bool LiveScene::load(const std::string& sceneFile, std::optional<uint64_t> seed,
     // voxel volume follows it); one without stands in the box under its lamp, fitted.
     if (isGltfFile(sceneFile) && !models[0].model->lights.empty()) {
         scene.box.walls = false;
+        scene.box.lamp = false;
         scene.models[0].fit = false;
         models[0].placement = placementOf(scene.models[0], *models[0].model, false);
     }

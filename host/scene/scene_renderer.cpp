@@ -143,6 +143,7 @@ void SceneRenderer::buildMeshes() {
         }
         materialBase += uint32_t(mdl.materials.size());
     }
+    buildRayMeshes(vertices, indices);
     vertexBuffer_ = gl::Buffer::create(static_cast<GLsizeiptr>(vertices.size() * sizeof(Vertex)), vertices.data(), 0,
                                        "scene.vertices");
     surfaceBuffer_ = gl::Buffer::create(static_cast<GLsizeiptr>(surface.size() * sizeof(SurfaceVertex)),
@@ -173,6 +174,45 @@ void SceneRenderer::buildMeshes() {
     glVertexArrayVertexBuffer(vao_.id(), 0, vertexBuffer_.id(), 0, sizeof(Vertex));
     glVertexArrayVertexBuffer(vao_.id(), 2, surfaceBuffer_.id(), 0, sizeof(SurfaceVertex));
     glVertexArrayElementBuffer(vao_.id(), indexBuffer_.id());
+}
+
+void SceneRenderer::buildRayMeshes(const std::vector<Vertex>& vertices, const std::vector<uint32_t>& indices) {
+    rayData_ = {};
+    std::vector<glm::vec3> positions;
+    for (size_t m = kMeshCount; m < meshes_.size(); ++m) {
+        const MeshRange& r = meshes_[m];
+        const uint32_t end = m + 1 < meshes_.size() ? meshes_[m + 1].baseVertex : uint32_t(vertices.size());
+        positions.clear();
+        for (uint32_t v = r.baseVertex; v < end; ++v) positions.push_back(vertices[v].position);
+        rayData_.addMesh({positions, std::span(indices).subspan(r.firstIndex, r.indexCount), r.firstIndex});
+    }
+    // The instances of kSceneMeshes follow the planes and the light's surface.
+    const uint32_t first = uint32_t(staticInstances_.size());
+    std::vector<ray::RayInstanceSource> sources;
+    uint32_t k = 0;
+    for (const MeshGroup& g : meshGroups_)
+        for (uint32_t i = 0; i < g.instances; ++i, ++k)
+            sources.push_back({g.mesh - kMeshCount, meshInstances_[k].model, first + k, meshes_[g.mesh].baseVertex,
+                               g.twoSided});
+    rayData_.setInstances(sources);
+    auto upload = [](gl::Buffer& buffer, const auto& v, const char* name) {
+        buffer = v.empty() ? gl::Buffer{}
+                           : gl::Buffer::create(static_cast<GLsizeiptr>(v.size() * sizeof(v[0])), v.data(), 0, name);
+    };
+    upload(rayNodes_, rayData_.nodes(), "scene.ray_nodes");
+    upload(rayTriangles_, rayData_.triangles(), "scene.ray_triangles");
+    upload(rayInstances_, rayData_.instances(), "scene.ray_instances");
+}
+
+kiln::RayMeshes SceneRenderer::rayMeshes() const {
+    kiln::RayMeshes r;
+    if (rayData_.instances().empty()) return r;
+    r.nodes = rayNodes_.id(), r.triangles = rayTriangles_.id(), r.instances = rayInstances_.id();
+    r.vertices = vertexBuffer_.id(), r.surface = surfaceBuffer_.id(), r.indices = indexBuffer_.id();
+    r.topRoot = rayData_.topRoot();
+    r.instanceCount = uint32_t(rayData_.instances().size());
+    r.triangleCount = rayData_.triangles().size();
+    return r;
 }
 
 GpuInstance SceneRenderer::materialInstance(const model::Model& mdl, uint32_t materialBase, int material,
@@ -213,7 +253,7 @@ void SceneRenderer::setLook(const SceneLook& look) {
     }
     const size_t walls = staticInstances_.size();
     // The lamp dome: its mesh is already in world space.
-    if (look.walls)
+    if (look.lamp)
         staticInstances_.push_back(
             {I, glm::vec4(look.lampColor, 0.0f), glm::vec4(look.lampColor * look.lampIntensity, 0.0f)});
     // The tumbler's mesh about its origin (the lower ball's centre): the upper ball's top.

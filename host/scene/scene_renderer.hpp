@@ -19,6 +19,8 @@
 #include "kiln/gl.hpp"
 #include "kiln/scene_view.hpp"
 #include "model/model.hpp"
+#include "scene/mesh.hpp"
+#include "ray/ray_meshes.hpp"
 #include "run/pass_context.hpp"
 
 namespace kiln::scene {
@@ -32,7 +34,8 @@ struct SceneLook {
     float woodRingFrequency = 14.0f;
     glm::vec3 wallEmission{0.0f};  // radiance every wall emits
     bool closed = false;           // a front wall at z = +1 (colour `other`)
-    bool walls = true;             // false: no walls and no lamp dome (a model alone)
+    bool walls = true;             // false: no walls (a model alone)
+    bool lamp = true;              // the lamp dome (clipped at y = 1, where the ceiling is)
     glm::vec3 lampCentre{0.0f, 1.1f, 0.0f};
     float lampRadius = 0.35f;
     glm::vec3 lampColor{1.0f, 0.95f, 0.85f};
@@ -108,6 +111,10 @@ public:
     // The models the scene file places (kSceneMeshes): their meshes, instances and
     // textures. Returns false with a one-line error (GPU memory) and keeps the last ones.
     bool setModels(const std::vector<PlacedModel>&, std::string& error);
+    // The placed meshes' ray-tracing buffers (SceneView::rayMeshes), as last uploaded.
+    kiln::RayMeshes rayMeshes() const;
+    // The same on the CPU (tests and the CPU tracers read it).
+    const ray::RayMeshData& rayMeshData() const { return rayData_; }
     // The texture arrays of SceneView::materialTextures (0 where there are none).
     GLuint materialTexture(int which) const { return which == 0 ? colorLayers_.id() : dataLayers_.id(); }
     // The camera, for the spheres' level of detail and the particles' order: its
@@ -166,6 +173,8 @@ private:
     };
     std::vector<MaterialLayers> materialLayers_;
     void rebuildGroups();
+    // The placed meshes' hierarchies (from the vertices and indices buildMeshes made).
+    void buildRayMeshes(const std::vector<Vertex>& vertices, const std::vector<uint32_t>& indices);
     // Orders each sphere category's instances near → mid → far by their size on
     // screen and keeps the three counts in sphereLevels_; whether any tumbler is near.
     void chooseLevels();
@@ -180,6 +189,8 @@ private:
     struct MeshGroup { uint32_t mesh, instances; bool twoSided; };
     std::vector<MeshGroup> meshGroups_;
     gl::Buffer vertexBuffer_, surfaceBuffer_, indexBuffer_;
+    ray::RayMeshData rayData_;
+    gl::Buffer rayNodes_, rayTriangles_, rayInstances_;
     gl::TextureHandle colorLayers_, dataLayers_;
     gl::VertexArrayHandle vao_;
     gl::Buffer instanceBuffer_, instanceIds_;

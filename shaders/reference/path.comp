@@ -2,11 +2,14 @@
 // A progressive path tracer over the analytic scene (reference/shapes.glsl) with the
 // rasterizer's materials: Lambert, the instances' albedos, the floor's procedural wood.
 // Each dispatch adds u_samples paths per pixel to a running mean.
+//   - the placed meshes' triangles through the host's BVH, with their materials (base
+//     colour and emissive textures, normal maps, cut-outs, one- and two-sided);
 //   - next-event estimation toward the lamp's sphere (uniform in its cone of
 //     directions; a direction whose first hit is the ceiling, not the dome, is simply
-//     occluded) and toward the fireballs, one light picked per vertex;
+//     occluded), the fireballs and the punctual lights (a shadow ray each), one light
+//     picked per vertex;
 //   - BSDF (cosine) sampling, combined with NEE by the power heuristic for the lights
-//     NEE can pick; particles are reached by BSDF sampling only;
+//     NEE can pick; particles and emissive meshes are reached by BSDF sampling only;
 //   - Russian roulette from bounce u_rouletteStart on, so no depth bias below
 //     u_maxBounces.
 // Outputs: radiance = the full estimate; direct = what the rasterizer computes
@@ -27,6 +30,7 @@ uniform int u_samples;        // paths to add now
 uniform int u_maxBounces;
 uniform int u_rouletteStart;
 uniform bool u_jitter;        // pixel-area integration (the rasterizer samples centres)
+uniform int u_rowOffset;      // the band of rows this dispatch covers starts here
 
 const float kPi = 3.14159265358979;
 const float kEpsilon = 1e-4;
@@ -65,8 +69,51 @@ vec3 albedoAt(int instance, vec3 p) {
 }
 vec3 emissionOf(int instance) { return kiln_instances[instance].emissive.rgb; }
 
-// Lights NEE samples: 0 = the lamp, 1..F = fireball F−1. Probability of each.
-int lightCount() { return (u_count[kLamp] > 0 ? 1 : 0) + u_count[kFireballs]; }
+// What a path needs of the surface it hit: the material's albedo and emission there, the
+// shading normal and the geometric one, both facing the ray's origin.
+struct Surface {
+    vec3 albedo;
+    vec3 emission;
+    vec3 normal;
+    vec3 geometric;
+};
+Surface surfaceAt(Hit h, vec3 p, vec3 d) {
+    Surface s;
+    if (!h.onMesh) {
+        s.normal = s.geometric = dot(h.normal, d) > 0.0 ? -h.normal : h.normal;  // two-sided walls
+        s.albedo = albedoAt(h.instance, p);
+        s.emission = emissionOf(h.instance);
+        return s;
+    }
+    // A placed mesh: the G-buffer's material (gbuffer/textured.frag), read at the finest level.
+    KilnMeshSurface m = kilnMeshSurface(h.mesh);
+    KilnInstance inst = kiln_instances[m.instance];
+    vec4 base = inst.baseColor;
+    vec3 emission = inst.emission.rgb;
+    if (inst.layers.x >= 0.0) base *= textureLod(kiln_rayColorLayers, vec3(m.uv, inst.layers.x), 0.0);
+    if (inst.layers.y >= 0.0) emission *= textureLod(kiln_rayColorLayers, vec3(m.uv, inst.layers.y), 0.0).rgb;
+    bool back = dot(m.geometricNormal, d) > 0.0;
+    s.geometric = back ? -m.geometricNormal : m.geometricNormal;
+    vec3 n = back ? -m.normal : m.normal;
+    if (inst.layers.z >= 0.0) {
+        vec3 t = m.tangent.xyz - n * dot(n, m.tangent.xyz);
+        if (dot(t, t) > 1e-12) {
+            vec3 mapped = textureLod(kiln_rayDataLayers, vec3(m.uv, inst.layers.z), 0.0).xyz * 2.0 - 1.0;
+            t = normalize(t);
+            vec3 b = cross(n, t) * (m.tangent.w < 0.0 ? -1.0 : 1.0);
+            n = normalize(mapped.x * t + mapped.y * b + mapped.z * n);
+        }
+    }
+    s.normal = n;
+    s.albedo = base.rgb;
+    s.emission = emission;
+    return s;
+}
+
+// Lights NEE samples: 0 = the lamp, 1..F = fireball F−1 (the spheres), then the punctual
+// lights. Probability of each.
+int sphereLightCount() { return (u_count[kLamp] > 0 ? 1 : 0) + u_count[kFireballs]; }
+int lightCount() { return sphereLightCount() + int(u_punctualCount.x); }
 float lightPick() { return 1.0 / float(max(lightCount(), 1)); }
 void lightSphere(int k, out vec3 c, out float r, out int instance) {
     if (u_count[kLamp] > 0 && k == 0) {
@@ -90,6 +137,41 @@ float coneDensity(vec3 p, vec3 c, float r) {
 }
 float powerHeuristic(float a, float b) { return a * a / (a * a + b * b); }
 
+// A punctual light seen from p (common/punctual.glsl's radiometry, its visibility by a
+// shadow ray): the unit direction to it, how far it is (directional: unbounded) and the
+// irradiance it gives a surface facing it.
+void punctualToward(KilnPunctualLight light, vec3 p, out vec3 l, out float dist, out vec3 irradiance) {
+    l = -light.direction.xyz;
+    dist = kNoHit;
+    float falloff = 1.0;
+    if (light.position.w > 0.5) {
+        vec3 toLight = light.position.xyz - p;
+        float dist2 = max(dot(toLight, toLight), 1e-8);
+        dist = sqrt(dist2);
+        l = toLight / dist;
+        falloff = 1.0 / dist2;
+        if (light.direction.w > 0.0) {
+            float r2 = dist2 / (light.direction.w * light.direction.w);
+            float window = clamp(1.0 - r2 * r2, 0.0, 1.0);
+            falloff *= window * window;
+        }
+        if (light.position.w > 1.5) {
+            float t = clamp((dot(-l, light.direction.xyz) - light.cone.x) * light.cone.y, 0.0, 1.0);
+            falloff *= t * t;
+        }
+    }
+    irradiance = light.color.rgb * falloff;
+}
+
+// Where a ray leaving a mesh's surface starts: off it along the geometric normal by a
+// margin that grows with the distance from the origin (float spacing), so it does not
+// hit the triangle it left. The analytic shapes keep the ray's own tMin.
+vec3 leaving(Hit h, vec3 p, vec3 geometric) {
+    if (!h.onMesh) return p;
+    float scale = max(max(abs(p.x), abs(p.y)), max(abs(p.z), 1.0));
+    return p + geometric * (2e-5 * scale);
+}
+
 void tracePath(vec3 o, vec3 d, out vec3 total, out vec3 direct) {
     total = vec3(0.0), direct = vec3(0.0);
     vec3 throughput = vec3(1.0);
@@ -99,8 +181,9 @@ void tracePath(vec3 o, vec3 d, out vec3 total, out vec3 direct) {
         Hit h = traceScene(o, d, depth == 0 ? 0.0 : kEpsilon);
         if (h.instance < 0) break;
         vec3 p = o + h.t * d;
-        vec3 n = dot(h.normal, d) > 0.0 ? -h.normal : h.normal;  // two-sided walls
-        vec3 e = emissionOf(h.instance);
+        Surface surface = surfaceAt(h, p, d);
+        vec3 n = surface.normal;
+        vec3 e = surface.emission;
         if (any(greaterThan(e, vec3(0.0)))) {
             float w = 1.0;
             if (depth > 0 && isNeeLight(h.instance)) {
@@ -112,42 +195,60 @@ void tracePath(vec3 o, vec3 d, out vec3 total, out vec3 direct) {
             total += contribution;
             if (depth == 0 || (depth == 1 && h.instance == u_first[kLamp] && u_count[kLamp] > 0)) direct += contribution;
         }
-        vec3 albedo = albedoAt(h.instance, p);
+        vec3 albedo = surface.albedo;
         if (all(equal(albedo, vec3(0.0))) || depth == u_maxBounces) break;
+        vec3 start = leaving(h, p, surface.geometric);
 
-        // Next-event estimation: one light, a direction in its cone, one shadow ray.
+        // Next-event estimation: one light, a direction toward it, one shadow ray.
         int lights = lightCount();
         if (lights > 0) {
             int k = min(int(rand() * float(lights)), lights - 1);
-            vec3 c;
-            float r;
-            int instance;
-            lightSphere(k, c, r, instance);
-            float density = coneDensity(p, c, r);
             float u = rand(), v = rand();
-            if (density > 0.0) {
-                vec3 axis = normalize(c - p);
-                float cosMax = sqrt(1.0 - r * r / dot(c - p, c - p));
-                float cosT = 1.0 - u * (1.0 - cosMax), sinT = sqrt(max(0.0, 1.0 - cosT * cosT));
-                vec3 t, b;
-                basis(axis, t, b);
-                vec3 l = normalize(t * (sinT * cos(2.0 * kPi * v)) + b * (sinT * sin(2.0 * kPi * v)) + axis * cosT);
+            if (k < sphereLightCount()) {
+                vec3 c;
+                float r;
+                int instance;
+                lightSphere(k, c, r, instance);
+                float density = coneDensity(p, c, r);
+                if (density > 0.0) {
+                    vec3 axis = normalize(c - p);
+                    float cosMax = sqrt(1.0 - r * r / dot(c - p, c - p));
+                    float cosT = 1.0 - u * (1.0 - cosMax), sinT = sqrt(max(0.0, 1.0 - cosT * cosT));
+                    vec3 t, b;
+                    basis(axis, t, b);
+                    vec3 l = normalize(t * (sinT * cos(2.0 * kPi * v)) + b * (sinT * sin(2.0 * kPi * v)) + axis * cosT);
+                    float cosSurface = dot(n, l);
+                    if (cosSurface > 0.0 && dot(surface.geometric, l) > 0.0) {
+                        Hit s = traceScene(start, l, kEpsilon);
+                        if (s.instance == instance) {
+                            float lightPdf = lightPick() * density;
+                            float w = powerHeuristic(lightPdf, cosSurface / kPi);
+                            vec3 contribution = throughput * albedo / kPi * emissionOf(instance) * cosSurface * w / lightPdf;
+                            total += contribution;
+                            if (depth == 0 && k == 0 && u_count[kLamp] > 0) direct += contribution;
+                        }
+                    }
+                }
+            } else {
+                vec3 l, irradiance;
+                float dist;
+                punctualToward(u_punctual[k - sphereLightCount()], p, l, dist, irradiance);
                 float cosSurface = dot(n, l);
-                if (cosSurface > 0.0) {
-                    Hit s = traceScene(p, l, kEpsilon);
-                    if (s.instance == instance) {
-                        float lightPdf = lightPick() * density;
-                        float w = powerHeuristic(lightPdf, cosSurface / kPi);
-                        vec3 contribution = throughput * albedo / kPi * emissionOf(instance) * cosSurface * w / lightPdf;
+                if (cosSurface > 0.0 && dot(surface.geometric, l) > 0.0 && any(greaterThan(irradiance, vec3(0.0)))) {
+                    Hit s = traceScene(start, l, kEpsilon);
+                    if (s.instance < 0 || s.t >= dist) {
+                        vec3 contribution = throughput * albedo / kPi * irradiance * cosSurface / lightPick();
                         total += contribution;
-                        if (depth == 0 && k == 0 && u_count[kLamp] > 0) direct += contribution;
+                        if (depth == 0) direct += contribution;
                     }
                 }
             }
         }
 
-        // Continue: cosine sampling makes the Lambert weight exactly the albedo.
+        // Continue: cosine sampling makes the Lambert weight exactly the albedo. A
+        // direction below the true surface (a shading normal tilted past it) ends the path.
         vec3 next = cosineSample(n);
+        if (h.onMesh && dot(next, surface.geometric) <= 0.0) break;
         bsdfPdf = max(dot(n, next), 0.0) / kPi;
         throughput *= albedo;
         if (depth >= u_rouletteStart) {
@@ -156,13 +257,13 @@ void tracePath(vec3 o, vec3 d, out vec3 total, out vec3 direct) {
             throughput /= keep;
         }
         previous = p;
-        o = p;
+        o = start;
         d = next;
     }
 }
 
 void main() {
-    ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+    ivec2 pixel = ivec2(gl_GlobalInvocationID.xy) + ivec2(0, u_rowOffset);
     ivec2 size = imageSize(u_radiance);
     if (any(greaterThanEqual(pixel, size))) return;
     vec3 sumTotal = vec3(0.0), sumDirect = vec3(0.0);

@@ -4,9 +4,11 @@
 //   lamp        the sphere u_lightPos below the ceiling y = 1 (its instance: material)
 //   tumblers    the round cone u_roundCone placed by the model (rigid)
 //   spheres     marbles, fireballs, particles: model = translate × scale(radius)
+//   meshes      the placed models' triangles, through the host's BVH (common/ray_meshes.glsl)
 // Ranges come from the host's category counts (u_first/u_count, SceneView order).
 #include "common/frame.glsl"
 #include "common/instances.glsl"
+#include "common/ray_meshes.glsl"
 
 const int kBox = 0, kLamp = 1, kMeshes = 2, kTumblers = 3, kMarbles = 4, kFireballs = 5, kParticles = 6;
 uniform int u_first[7];
@@ -16,8 +18,10 @@ const float kNoHit = 1e30;
 
 struct Hit {
     float t;
-    vec3 normal;   // outward, unit
+    vec3 normal;   // outward, unit (meshes: see `mesh`)
     int instance;  // -1: nothing
+    bool onMesh;   // a placed mesh's triangle: kilnMeshSurface(mesh) gives the surface
+    KilnMeshHit mesh;
 };
 
 // Rigid model: world → local without a general inverse.
@@ -78,7 +82,7 @@ float roundConeHit(vec3 o, vec3 d, float tMin, out vec3 normal) {
 }
 
 Hit traceScene(vec3 o, vec3 d, float tMin) {
-    Hit h = Hit(kNoHit, vec3(0.0), -1);
+    Hit h = Hit(kNoHit, vec3(0.0), -1, false, KilnMeshHit(0.0, 0u, 0u, vec2(0.0)));
     for (int i = u_first[kBox]; i < u_first[kBox] + u_count[kBox]; ++i) {
         mat4 m = kiln_instances[i].model;
         vec3 n = m[1].xyz;
@@ -88,13 +92,13 @@ Hit traceScene(vec3 o, vec3 d, float tMin) {
         if (t <= tMin || t >= h.t) continue;
         vec3 q = toLocal(m, o + t * d);
         if (abs(q.x) > 1.0 || abs(q.z) > 1.0) continue;
-        h = Hit(t, n, i);
+        h.t = t, h.normal = n, h.instance = i;
     }
     if (u_count[kLamp] > 0) {
         vec3 c = u_lightPos.xyz;
         float r = u_lightPos.w;
         float t = sphereEntry(o, d, c, r, tMin);
-        if (t < h.t && o.y + t * d.y <= kCeilingY) h = Hit(t, (o + t * d - c) / r, u_first[kLamp]);
+        if (t < h.t && o.y + t * d.y <= kCeilingY) h.t = t, h.normal = (o + t * d - c) / r, h.instance = u_first[kLamp];
     }
     for (int i = u_first[kTumblers]; i < u_first[kTumblers] + u_count[kTumblers]; ++i) {
         mat4 m = kiln_instances[i].model;
@@ -106,14 +110,19 @@ Hit traceScene(vec3 o, vec3 d, float tMin) {
         if (bb * bb - dot(om, om) + reach * reach < 0.0) continue;
         vec3 n;
         float t = roundConeHit(toLocal(m, o), dirToLocal(m, d), tMin, n);
-        if (t < h.t) h = Hit(t, mat3(m) * n, i);
+        if (t < h.t) h.t = t, h.normal = mat3(m) * n, h.instance = i;
     }
     for (int i = u_first[kMarbles]; i < u_first[kParticles] + u_count[kParticles]; ++i) {
         mat4 m = kiln_instances[i].model;
         vec3 c = m[3].xyz;
         float r = length(m[0].xyz);
         float t = sphereEntry(o, d, c, r, tMin);
-        if (t < h.t) h = Hit(t, (o + t * d - c) / r, i);
+        if (t < h.t) h.t = t, h.normal = (o + t * d - c) / r, h.instance = i;
+    }
+    KilnMeshHit m;
+    if (kilnTraceMeshes(o, d, tMin, h.t, m)) {
+        h.t = m.t, h.instance = int(kiln_rayInstances[m.rayInstance].instance);
+        h.onMesh = true, h.mesh = m;
     }
     return h;
 }

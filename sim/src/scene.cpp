@@ -296,6 +296,8 @@ bool readBox(const Json& root, Scene& s, SceneError& error) {
             !r.vec<3>("other", s.box.other, 0, 1) || !r.vec<3>("emission", s.box.emission, 0, 1e4) ||
             !r.boolean("closed", s.box.closed) || !r.boolean("walls", s.box.walls))
             return false;
+        s.box.lamp = s.box.walls;
+        if (!r.boolean("lamp", s.box.lamp)) return false;
         r.known.insert("floor_wood");
         const Json* w = nullptr;
         if (!object(*o, "floor_wood", "box.floor_wood", error, w)) return false;

@@ -177,7 +177,7 @@ TEST_CASE("voxel_mip bounces: each bounce adds what the path tracer's next path 
         const FloatImage frame = rasterFrame(rig, k);
         const metrics::Mask lit = notEmissive(rig);
         rig.load(pipeline("reference.radiance", R"({"id": "reference", "module": "reference",
-                 "params": {"samples_per_frame": 64, "max_bounces": )" + std::to_string(k + 1) + "}}"));
+                 "params": {"samples_per_frame": 64, "budget_ms": 0, "max_bounces": )" + std::to_string(k + 1) + "}}"));
         for (int f = 0; f < 4; ++f) rig.app.frame();
         rig.checkNoErrors();
         const double reference = metrics::meanLuminance(rig.image("reference", "radiance"), lit);
@@ -216,7 +216,7 @@ TEST_CASE("cone_trace: in an open box of glowing walls the gathered light is the
     const double glow = metrics::meanLuminance(rasterFrame(rig, 0, "fixed_cones", kSamplesOffByADiameter));
     const double raster = metrics::meanLuminance(rasterFrame(rig, 1, "fixed_cones", kSamplesOffByADiameter));
     rig.load(pipeline("reference.radiance", R"({"id": "reference", "module": "reference",
-             "params": {"samples_per_frame": 64, "max_bounces": 1}})"));
+             "params": {"samples_per_frame": 64, "budget_ms": 0, "max_bounces": 1}})"));
     for (int f = 0; f < 4; ++f) rig.app.frame();
     rig.checkNoErrors();
     const double reference = metrics::meanLuminance(rig.image("reference", "radiance"));

@@ -15,10 +15,11 @@ using namespace kiln::test;
 
 namespace {
 
+// Every requested path in its frame (no time budget), whatever the machine's speed.
 std::string referencePipeline(int samplesPerFrame, int seed, int maxBounces = 16) {
     return pipeline("reference.radiance", R"({"id": "reference", "module": "reference", "params": {"samples_per_frame": )" +
                                               std::to_string(samplesPerFrame) + R"(, "seed": )" + std::to_string(seed) +
-                                              R"(, "max_bounces": )" + std::to_string(maxBounces) + "}}");
+                                              R"(, "max_bounces": )" + std::to_string(maxBounces) + R"(, "budget_ms": 0}})");
 }
 
 // Renders `samples` paths per pixel in `frames` frames and reads the mean back.
@@ -84,6 +85,50 @@ TEST_CASE("reference: 256 paths in one frame equal 256 paths over 32 frames (no 
     for (size_t i = 0; i < once.pixels.size(); i += 4) a += once.pixels[i + 1], b += spread.pixels[i + 1];
     INFO("mean green " << a / (once.pixels.size() / 4) << " vs " << b / (spread.pixels.size() / 4));
     CHECK(std::abs(a - b) <= 1e-4 * b);
+}
+
+TEST_CASE("reference: a frame stopped by its time budget goes on next frame, and the image is the same bit for bit",
+          "[gi][reference]") {
+    // 136 rows are three bands (64, 64, 8). With a budget of 1 ms a frame stops after the
+    // first band whose dispatch outlasts it, wherever the machine's speed puts that; so
+    // what is asserted holds at any speed: after every frame each band holds the paths of
+    // the passes before it or one pass more, the later bands never ahead of the earlier,
+    // and once converged the image equals one rendered without a budget, bit for bit.
+    const std::string scene = stillScene();
+    auto pipelineWith = [](int budgetMs) {
+        return pipeline("reference.radiance",
+                        R"({"id": "reference", "module": "reference", "params": {"samples_per_frame": 2, )"
+                        R"("max_samples": 6, "budget_ms": )" + std::to_string(budgetMs) + "}}");
+    };
+    FloatImage whole, budgeted;
+    {
+        Rig rig(scene, 136);
+        rig.load(pipelineWith(0));
+        for (int f = 0; f < 3; ++f) rig.app.frame();
+        whole = rig.image("reference", "radiance");
+        REQUIRE(whole.at(0, 135)[3] == 6.0f);
+    }
+    Rig rig(scene, 136);
+    rig.load(pipelineWith(1));
+    int frames = 0;
+    for (; frames < 200; ++frames) {
+        rig.app.frame();
+        rig.checkNoErrors();
+        budgeted = rig.image("reference", "radiance");
+        const float bands[3] = {budgeted.at(5, 0)[3], budgeted.at(5, 64)[3], budgeted.at(5, 128)[3]};
+        INFO("frame " << frames << ": paths " << bands[0] << ", " << bands[1] << ", " << bands[2]);
+        for (int b = 0; b < 3; ++b) {
+            const int rows = b < 2 ? 64 : 8;
+            for (int y = b * 64; y < b * 64 + rows; ++y) REQUIRE(budgeted.at(131, y)[3] == bands[b]);  // a band moves whole
+        }
+        CHECK(bands[0] >= bands[1]);
+        CHECK(bands[1] >= bands[2]);
+        CHECK(bands[0] - bands[2] <= 2.0f);
+        if (bands[2] == 6.0f) break;
+    }
+    WARN("converged in " << frames + 1 << " frames of 1 ms budget (3 without)");
+    REQUIRE(budgeted.pixels.size() == whole.pixels.size());
+    CHECK(std::memcmp(budgeted.pixels.data(), whole.pixels.data(), whole.pixels.size() * sizeof(float)) == 0);
 }
 
 TEST_CASE("reference: the same seed gives the same image bit for bit, another seed another image",

@@ -210,6 +210,7 @@
 #include <initializer_list>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -231,7 +232,7 @@ namespace kiln {
 // kScenePlanes, kSceneLightSurface, kSceneRoundCones, kSceneSpheres,
 // kSceneGlowingSpheres, kSceneLights, GpuFrame::ringsLight/ringsDark, roundCone,
 // closedFaces), so a module built for other terms is refused by name, not run.
-inline constexpr uint32_t kPassAbiVersion = 16;
+inline constexpr uint32_t kPassAbiVersion = 17;
 
 struct TextureRef {
     GLuint id = 0;
@@ -339,6 +340,22 @@ void forEachRedrawRect(const PassContext& ctx, int width, int height, int grow, 
         draw();
     }
     glDisable(GL_SCISSOR_TEST);
+}
+
+// Binds the scene's ray-tracing buffers and material textures (SceneView::rayMeshes)
+// for shaders/common/ray_meshes.glsl, and sets its two uniforms in `program` (which
+// must be in use).
+inline void bindRayMeshes(const SceneView& scene, GLuint program) {
+    const RayMeshes& r = scene.rayMeshes;
+    const std::pair<unsigned, uint32_t> buffers[] = {
+        {kRayNodeBinding, r.nodes},     {kRayTriangleBinding, r.triangles}, {kRayInstanceBinding, r.instances},
+        {kRayVertexBinding, r.vertices}, {kRaySurfaceBinding, r.surface},    {kRayIndexBinding, r.indices}};
+    for (const auto& [binding, buffer] : buffers)
+        if (buffer) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding, buffer);
+    if (scene.materialTextures[0]) glBindTextureUnit(kRayColorLayersUnit, scene.materialTextures[0]);
+    if (scene.materialTextures[1]) glBindTextureUnit(kRayDataLayersUnit, scene.materialTextures[1]);
+    glUniform1ui(glGetUniformLocation(program, "u_rayTopRoot"), r.topRoot);
+    glUniform1ui(glGetUniformLocation(program, "u_rayInstanceCount"), r.nodes ? r.instanceCount : 0u);
 }
 
 }  // namespace kiln

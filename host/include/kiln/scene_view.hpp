@@ -126,8 +126,30 @@ constexpr int sceneCategoryIndex(uint32_t c) {
     return -1;
 }
 
+// The placed meshes (kSceneMeshes) as a ray tracer reads them: a bounding volume
+// hierarchy per mesh over its triangles and one over the instances, with the scene's
+// vertex and index buffers, traversed by shaders/common/ray_meshes.glsl
+// (kilnTraceMeshes, kilnMeshSurface). A compute pass binds them with
+// kiln::bindRayMeshes (kiln/pass.hpp). Rebuilt when the placed models change; the
+// moving bodies are not in it (their shapes are exact: a sphere or a round cone placed
+// by its GpuInstance::model).
+struct RayMeshes {
+    uint32_t nodes = 0, triangles = 0, instances = 0;  // GL buffer names (0: no meshes)
+    uint32_t vertices = 0, surface = 0, indices = 0;   // the scene's vertex streams and indices
+    uint32_t topRoot = 0;                              // the instances' root node
+    uint32_t instanceCount = 0;
+    uint64_t triangleCount = 0;
+};
+// Shader storage bindings of ray_meshes.glsl (with the instances' at 0, seven of the eight
+// OpenGL 4.5 guarantees a compute shader: 1 is left to the pass), and the texture units of
+// its material lookups (cut-outs, and the shader's own reads through kiln_rayColorLayers).
+inline constexpr unsigned kRayNodeBinding = 2, kRayTriangleBinding = 3, kRayInstanceBinding = 4,
+                          kRayVertexBinding = 5, kRaySurfaceBinding = 6, kRayIndexBinding = 7;
+inline constexpr unsigned kRayColorLayersUnit = 12, kRayDataLayersUnit = 13;
+
 struct SceneView {
     GpuFrame frame{};
+    RayMeshes rayMeshes;
     // The placed meshes' textures: GL_TEXTURE_2D_ARRAY names, [0] sRGB colour (base colour
     // and emissive layers), [1] linear data (normal maps, rgb = xyz × 0.5 + 0.5 in tangent
     // space); layers chosen by GpuInstance::layers. 0 when the scene has none.

@@ -12,8 +12,10 @@
 //       "floor_wood": { "light": [r,g,b], "dark": [r,g,b], "ring_frequency": 14 },
 //       "emission": [r,g,b],                     // radiance every wall emits (default 0)
 //       "closed": false,                         // a front wall at z = +1 (colour "other")
-//       "walls": true                            // false: no walls and no lamp, and then no
-//     },                                         //   tumblers, marbles or fireballs
+//       "walls": true,                           // false: no walls and no lamp, and then no
+//                                                //   tumblers, marbles or fireballs
+//       "lamp": true                             // the lamp (default: as "walls"); with no
+//     },                                         //   walls it hangs alone, clipped at y = 1
 //     "lamp": { "center": [0, 1.1, 0], "radius": 0.35,   // sphere clipped by the ceiling: the
 //               "color": [r,g,b], "intensity": 20 },     // dome below y = 1 emits the
 //                                                        // radiance color × intensity
@@ -107,8 +109,10 @@ struct Scene {
         } floorWood;
         glm::dvec3 emission{0.0};  // radiance of every wall (a white-furnace test sets it)
         bool closed = false;       // a sixth wall closes the front (camera inside)
-        bool walls = true;         // false: no walls and no lamp (a model lit by its own lights);
-                                   //   such a scene holds no bodies
+        bool walls = true;         // false: no walls (a model lit by its own lights); such a
+                                   //   scene holds no bodies
+        bool lamp = true;          // the lamp; the file's default is `walls` (a model that is
+                                   //   its own room can keep the box's lamp)
     } box;
     struct Lamp {
         glm::dvec3 center{0.0, 1.1, 0.0};
