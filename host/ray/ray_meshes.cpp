@@ -22,6 +22,8 @@ uint32_t appendNodes(std::vector<BvhNode>& nodes, const Bvh& bvh, uint32_t leafB
 void RayMeshData::addMesh(const RayMeshSource& mesh) {
     nodes_.resize(meshNodes_);  // a top level built before no longer holds
     instances_.clear();
+    emitters_.clear();
+    emittedPower_ = 0.0f;
     const size_t count = mesh.indices.size() / 3;
     std::vector<Aabb> bounds(count);
     Aabb all;
@@ -33,8 +35,10 @@ void RayMeshData::addMesh(const RayMeshSource& mesh) {
     if (bvh.nodes.empty()) {
         meshRoots_.push_back(UINT32_MAX);
         meshBounds_.push_back({});
+        meshTriangles_.push_back({});
         return;
     }
+    meshTriangles_.push_back({uint32_t(triangles_.size()), uint32_t(bvh.order.size())});
     const uint32_t root = appendNodes(nodes_, bvh, uint32_t(triangles_.size()));
     for (uint32_t t : bvh.order) {
         const glm::vec3 a = mesh.positions[mesh.indices[3 * t]], b = mesh.positions[mesh.indices[3 * t + 1]],
@@ -49,6 +53,8 @@ void RayMeshData::addMesh(const RayMeshSource& mesh) {
 void RayMeshData::setInstances(std::span<const RayInstanceSource> sources) {
     nodes_.resize(meshNodes_);
     instances_.clear();
+    emitters_.clear();
+    emittedPower_ = 0.0f;
     std::vector<Aabb> bounds(sources.size());
     for (size_t i = 0; i < sources.size(); ++i)
         if (sources[i].mesh < meshRoots_.size() && meshRoots_[sources[i].mesh] != UINT32_MAX)
@@ -61,7 +67,22 @@ void RayMeshData::setInstances(std::span<const RayInstanceSource> sources) {
         const glm::mat4 rows = glm::transpose(inverse);
         instances_.push_back({{rows[0], rows[1], rows[2]}, meshRoots_[s.mesh], s.instance, s.baseVertex,
                               s.twoSided ? 1u : 0u});
+        if (!(s.emitted > 0.0f)) continue;
+        const glm::mat3 linear(s.model);
+        const Range r = meshTriangles_[s.mesh];
+        for (uint32_t t = r.first; t < r.first + r.count; ++t) {
+            const RayTriangle& tri = triangles_[t];
+            const glm::vec3 e1 = linear * tri.e1, e2 = linear * tri.e2;
+            const float power = 0.5f * glm::length(glm::cross(e1, e2)) * s.emitted;
+            if (!(power > 0.0f)) continue;
+            emittedPower_ += power;
+            emitters_.push_back({glm::vec3(s.model * glm::vec4(tri.v0, 1.0f)), emittedPower_, e1,
+                                 uint32_t(instances_.size() - 1), e2, t});
+        }
     }
+    // Running sums → shares: the last is 1 exactly, so a uniform number always lands.
+    for (RayEmitter& e : emitters_) e.cdf /= emittedPower_;
+    if (!emitters_.empty()) emitters_.back().cdf = 1.0f;
     topRoot_ = appendNodes(nodes_, bvh, 0);
 }
 

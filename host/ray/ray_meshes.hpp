@@ -37,6 +37,19 @@ struct RayInstance {
 static_assert(sizeof(RayInstance) == 64);
 
 // What a mesh's triangles are read from: positions by index (baseVertex already added).
+// An emitting triangle, in world space, for sampling the light it gives: its cumulative
+// share of every emitter's power (area × the material's mean luminance), so a uniform
+// number picks one in proportion to its power.
+struct RayEmitter {
+    glm::vec3 v0;
+    float cdf;          // Σ of the shares up to and with this one; the last is 1
+    glm::vec3 e1;
+    uint32_t instance;  // into RayMeshData::instances()
+    glm::vec3 e2;
+    uint32_t triangle;  // into RayMeshData::triangles()
+};
+static_assert(sizeof(RayEmitter) == 48);
+
 struct RayMeshSource {
     std::span<const glm::vec3> positions;  // the mesh's vertices
     std::span<const uint32_t> indices;     // its triangles, three each
@@ -49,6 +62,7 @@ struct RayInstanceSource {
     uint32_t instance;  // into the scene's instance buffer
     uint32_t baseVertex;
     bool twoSided;
+    float emitted = 0.0f;  // the material's mean emitted luminance (0: it gives no light)
 };
 
 class RayMeshData {
@@ -61,6 +75,9 @@ public:
     const std::vector<BvhNode>& nodes() const { return nodes_; }
     const std::vector<RayTriangle>& triangles() const { return triangles_; }
     const std::vector<RayInstance>& instances() const { return instances_; }
+    // The emitting instances' triangles, and their power (Σ area × luminance).
+    const std::vector<RayEmitter>& emitters() const { return emitters_; }
+    float emittedPower() const { return emittedPower_; }
     // The top level's root in nodes(), valid when instances() is not empty.
     uint32_t topRoot() const { return topRoot_; }
     size_t meshCount() const { return meshRoots_.size(); }
@@ -70,6 +87,10 @@ private:
     size_t meshNodes_ = 0;        // nodes_[0 .. meshNodes_) are the meshes'
     std::vector<RayTriangle> triangles_;
     std::vector<RayInstance> instances_;
+    std::vector<RayEmitter> emitters_;
+    float emittedPower_ = 0.0f;
+    struct Range { uint32_t first = 0, count = 0; };
+    std::vector<Range> meshTriangles_;  // per mesh: its triangles in triangles_
     std::vector<uint32_t> meshRoots_;  // per mesh: its root (UINT32_MAX: no triangles)
     std::vector<Aabb> meshBounds_;
     uint32_t topRoot_ = 0;

@@ -43,6 +43,9 @@ namespace {
 
 // Whether `m` is a rotation, a uniform scale and a translation with no mirror: what
 // scene.glsl's normal transform (mat3(model)) and the G-buffer's facing assume.
+// Rec. 709 luminance of linear RGB: how the emitters' power is weighed.
+float luminance(glm::vec3 c) { return 0.2126f * c.r + 0.7152f * c.g + 0.0722f * c.b; }
+
 bool isSimilarity(const glm::mat4& m) {
     const glm::vec3 a(m[0]), b(m[1]), c(m[2]);
     const float la = glm::length(a), lb = glm::length(b), lc = glm::length(c);
@@ -193,7 +196,7 @@ void SceneRenderer::buildRayMeshes(const std::vector<Vertex>& vertices, const st
     for (const MeshGroup& g : meshGroups_)
         for (uint32_t i = 0; i < g.instances; ++i, ++k)
             sources.push_back({g.mesh - kMeshCount, meshInstances_[k].model, first + k, meshes_[g.mesh].baseVertex,
-                               g.twoSided});
+                               g.twoSided, luminance(glm::vec3(meshInstances_[k].emissive))});
     rayData_.setInstances(sources);
     auto upload = [](gl::Buffer& buffer, const auto& v, const char* name) {
         buffer = v.empty() ? gl::Buffer{}
@@ -202,6 +205,7 @@ void SceneRenderer::buildRayMeshes(const std::vector<Vertex>& vertices, const st
     upload(rayNodes_, rayData_.nodes(), "scene.ray_nodes");
     upload(rayTriangles_, rayData_.triangles(), "scene.ray_triangles");
     upload(rayInstances_, rayData_.instances(), "scene.ray_instances");
+    upload(rayEmitters_, rayData_.emitters(), "scene.ray_emitters");
 }
 
 kiln::RayMeshes SceneRenderer::rayMeshes() const {
@@ -212,6 +216,11 @@ kiln::RayMeshes SceneRenderer::rayMeshes() const {
     r.topRoot = rayData_.topRoot();
     r.instanceCount = uint32_t(rayData_.instances().size());
     r.triangleCount = rayData_.triangles().size();
+    if (!rayData_.emitters().empty()) {
+        r.emitters = rayEmitters_.id();
+        r.emitterCount = uint32_t(rayData_.emitters().size());
+        r.emittedPower = rayData_.emittedPower();
+    }
     return r;
 }
 

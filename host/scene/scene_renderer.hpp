@@ -190,7 +190,7 @@ private:
     std::vector<MeshGroup> meshGroups_;
     gl::Buffer vertexBuffer_, surfaceBuffer_, indexBuffer_;
     ray::RayMeshData rayData_;
-    gl::Buffer rayNodes_, rayTriangles_, rayInstances_;
+    gl::Buffer rayNodes_, rayTriangles_, rayInstances_, rayEmitters_;
     gl::TextureHandle colorLayers_, dataLayers_;
     gl::VertexArrayHandle vao_;
     gl::Buffer instanceBuffer_, instanceIds_;

@@ -25,6 +25,15 @@ struct KilnRayInstance {
     uint baseVertex;
     uint twoSided;
 };
+struct KilnRayEmitter {  // an emitting triangle, world space
+    vec3 v0;
+    float cdf;         // cumulative share of the emitted power; the last is 1
+    vec3 e1;
+    uint rayInstance;  // into kiln_rayInstances
+    vec3 e2;
+    uint triangle;     // into kiln_rayTriangles
+};
+layout(std430, binding = 1) readonly buffer KilnRayEmitters { KilnRayEmitter kiln_rayEmitters[]; };
 layout(std430, binding = 2) readonly buffer KilnRayNodes { KilnRayNode kiln_rayNodes[]; };
 layout(std430, binding = 3) readonly buffer KilnRayTriangles { KilnRayTriangle kiln_rayTriangles[]; };
 layout(std430, binding = 4) readonly buffer KilnRayInstances { KilnRayInstance kiln_rayInstances[]; };
@@ -37,6 +46,8 @@ layout(binding = 13) uniform sampler2DArray kiln_rayDataLayers;
 
 uniform uint u_rayTopRoot;        // kiln::bindRayMeshes sets both
 uniform uint u_rayInstanceCount;  // 0: no meshes
+uniform uint u_rayEmitterCount;   // 0: no mesh emits
+uniform float u_rayEmittedPower;  // Σ area × mean luminance over the emitters
 
 struct KilnMeshHit {
     float t;
@@ -188,5 +199,37 @@ KilnMeshSurface kilnMeshSurface(KilnMeshHit hit) {
     // Tangents are directions: they go world-ward by the model's linear part.
     s.tangent = vec4(inverse(worldToLocal) * t, sign);
     s.instance = ri.instance;
+    return s;
+}
+
+// Next-event estimation toward the emitting triangles: one picked in proportion to its
+// power (area × its material's mean luminance, GpuInstance::emissive), a point on it
+// uniformly (u, v, w uniform in [0, 1)). `hit` names the triangle and the point as a
+// ray hit would (kilnMeshSurface gives its material there); areaDensity is the sample's
+// density per unit area, which kilnEmitterDensity gives for a point a path hit itself.
+float kilnLuminance(vec3 c) { return dot(c, vec3(0.2126, 0.7152, 0.0722)); }
+float kilnEmitterDensity(uint instance) {
+    return u_rayEmittedPower > 0.0 ? kilnLuminance(kiln_instances[instance].emissive.rgb) / u_rayEmittedPower : 0.0;
+}
+struct KilnEmitterSample {
+    vec3 position;
+    vec3 normal;  // the winding's, unit
+    KilnMeshHit hit;
+    float areaDensity;
+};
+KilnEmitterSample kilnSampleEmitter(float u, float v, float w) {
+    uint lo = 0u, hi = u_rayEmitterCount - 1u;
+    while (lo < hi) {  // the first whose cumulative share reaches u
+        uint mid = (lo + hi) / 2u;
+        if (kiln_rayEmitters[mid].cdf < u) lo = mid + 1u; else hi = mid;
+    }
+    KilnRayEmitter e = kiln_rayEmitters[lo];
+    float r = sqrt(v);
+    vec2 bary = vec2(r * (1.0 - w), r * w);  // uniform over the triangle
+    KilnEmitterSample s;
+    s.position = e.v0 + e.e1 * bary.x + e.e2 * bary.y;
+    s.normal = normalize(cross(e.e1, e.e2));
+    s.hit = KilnMeshHit(0.0, e.rayInstance, e.triangle, bary);
+    s.areaDensity = kilnEmitterDensity(kiln_rayInstances[e.rayInstance].instance);
     return s;
 }

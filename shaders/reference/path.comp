@@ -6,10 +6,11 @@
 //     colour and emissive textures, normal maps, cut-outs, one- and two-sided);
 //   - next-event estimation toward the lamp's sphere (uniform in its cone of
 //     directions; a direction whose first hit is the ceiling, not the dome, is simply
-//     occluded), the fireballs and the punctual lights (a shadow ray each), one light
-//     picked per vertex;
+//     occluded), the fireballs, the punctual lights (a shadow ray each) and the
+//     emitting triangles (one by power, a point on it uniformly), one light picked
+//     per vertex;
 //   - BSDF (cosine) sampling, combined with NEE by the power heuristic for the lights
-//     NEE can pick; particles and emissive meshes are reached by BSDF sampling only;
+//     NEE can pick; particles are reached by BSDF sampling only;
 //   - Russian roulette from bounce u_rouletteStart on, so no depth bias below
 //     u_maxBounces.
 // Outputs: radiance = the full estimate; direct = what the rasterizer computes
@@ -113,7 +114,8 @@ Surface surfaceAt(Hit h, vec3 p, vec3 d) {
 // Lights NEE samples: 0 = the lamp, 1..F = fireball F−1 (the spheres), then the punctual
 // lights. Probability of each.
 int sphereLightCount() { return (u_count[kLamp] > 0 ? 1 : 0) + u_count[kFireballs]; }
-int lightCount() { return sphereLightCount() + int(u_punctualCount.x); }
+int lightCount() { return sphereLightCount() + int(u_punctualCount.x) + (u_rayEmitterCount > 0u ? 1 : 0); }
+bool isEmitterLight(int k) { return u_rayEmitterCount > 0u && k == lightCount() - 1; }
 float lightPick() { return 1.0 / float(max(lightCount(), 1)); }
 void lightSphere(int k, out vec3 c, out float r, out int instance) {
     if (u_count[kLamp] > 0 && k == 0) {
@@ -190,6 +192,13 @@ void tracePath(vec3 o, vec3 d, out vec3 total, out vec3 direct) {
                 vec3 c = h.instance == u_first[kLamp] ? u_lightPos.xyz : kiln_instances[h.instance].model[3].xyz;
                 float r = h.instance == u_first[kLamp] ? u_lightPos.w : length(kiln_instances[h.instance].model[0].xyz);
                 w = powerHeuristic(bsdfPdf, lightPick() * coneDensity(previous, c, r));
+            } else if (depth > 0 && h.onMesh && u_rayEmitterCount > 0u) {
+                // An emitting triangle next-event estimation could have picked: its
+                // density per solid angle from where the path came.
+                float cosLight = abs(dot(surface.geometric, d));
+                float density = kilnEmitterDensity(uint(h.instance));
+                if (density > 0.0 && cosLight > 0.0)
+                    w = powerHeuristic(bsdfPdf, lightPick() * density * h.t * h.t / cosLight);
             }
             vec3 contribution = throughput * e * w;
             total += contribution;
@@ -204,7 +213,23 @@ void tracePath(vec3 o, vec3 d, out vec3 total, out vec3 direct) {
         if (lights > 0) {
             int k = min(int(rand() * float(lights)), lights - 1);
             float u = rand(), v = rand();
-            if (k < sphereLightCount()) {
+            if (isEmitterLight(k)) {
+                KilnEmitterSample es = kilnSampleEmitter(u, v, rand());
+                vec3 toLight = es.position - start;
+                float dist2 = dot(toLight, toLight);
+                vec3 l = toLight * inversesqrt(max(dist2, 1e-20));
+                float cosLight = abs(dot(es.normal, l));
+                float cosSurface = dot(n, l);
+                if (cosSurface > 0.0 && dot(surface.geometric, l) > 0.0 && cosLight > 1e-6 && es.areaDensity > 0.0) {
+                    Hit s = traceScene(start, l, kEpsilon);
+                    if (s.onMesh && s.mesh.rayInstance == es.hit.rayInstance && s.mesh.triangle == es.hit.triangle) {
+                        vec3 emitted = surfaceAt(s, start + s.t * l, l).emission;
+                        float lightPdf = lightPick() * es.areaDensity * dist2 / cosLight;
+                        float w = powerHeuristic(lightPdf, cosSurface / kPi);
+                        total += throughput * albedo / kPi * emitted * cosSurface * w / lightPdf;
+                    }
+                }
+            } else if (k < sphereLightCount()) {
                 vec3 c;
                 float r;
                 int instance;

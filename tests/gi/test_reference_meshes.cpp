@@ -315,3 +315,63 @@ TEST_CASE("reference vs an independent renderer: Embree on the CPU agrees on a r
     CHECK(between < 1.2 * expected);
     CHECK(std::abs(mean(g1) + mean(g2) - mean(c1) - mean(c2)) < 0.02 * (mean(c1) + mean(c2)));
 }
+
+TEST_CASE("reference: an emitting glTF square lights a plate as Lambert's polygon formula says (next-event estimation)",
+          "[gi][reference][gltf]") {
+    // A 0.4 m square 0.5 m above a plate (albedo 0.5) emits L = 5 downward (one-sided, so
+    // the camera above sees through its back); nothing else. The plate's radiance is
+    // ρ/π·E with E = L/2 · Σ Θᵢ n·(vᵢ × vᵢ₊₁)/|vᵢ × vᵢ₊₁| over the square's edges seen from
+    // the point (the irradiance of a uniform polygon); light returning is nil (the square
+    // is black, the plate flat). Sampled by power and a uniform point, weighted against the
+    // cosine paths by MIS, 256 paths a pixel: each pixel within 5 % of the peak radiance
+    // (measured: the worst of 528 pixels 3.3 %, and 6.0 % at 64 paths — noise, falling
+    // as 1/√n), the mean over the plate within 1 % (measured 0.04 %).
+    constexpr float kHalf = 0.2f, kHeight = 0.5f, kRadiance = 5.0f;
+    std::vector<Quad> quads = {
+        {{glm::vec3(-2, 0, -2), glm::vec3(-2, 0, 2), glm::vec3(2, 0, 2), glm::vec3(2, 0, -2)}, 0},
+        {{glm::vec3(-kHalf, kHeight, -kHalf), glm::vec3(kHalf, kHeight, -kHalf), glm::vec3(kHalf, kHeight, kHalf),
+          glm::vec3(-kHalf, kHeight, kHalf)},
+         1},
+    };
+    nlohmann::json gltf = quadsGltf({quads}, nlohmann::json::array({diffuse(glm::vec3(0.5f), glm::vec3(0.0f), false),
+                                                                    diffuse(glm::vec3(0.0f), glm::vec3(1.0f), false)}));
+    gltf["materials"][1]["extensions"] = {{"KHR_materials_emissive_strength", {{"emissiveStrength", kRadiance}}}};
+    gltf["extensionsUsed"] = {"KHR_materials_emissive_strength"};
+    constexpr int kSide = 24;
+    Rig rig(sceneWithModel("emitting_square", gltf, {{"walls", false}}), kSide);
+    rig.app.camera().lookFrom({0.0f, 1.6f, 1.2f}, glm::normalize(glm::vec3(0.0f, -1.6f, -1.2f)), 1.0f);
+    const FloatImage img = renderReference(rig, 256, 4, 1);
+    const glm::mat4 inv = glm::inverse(rig.app.camera().projection(1.0f) * rig.app.camera().view());
+    const std::array<glm::vec3, 4> square = {glm::vec3(-kHalf, kHeight, -kHalf), glm::vec3(kHalf, kHeight, -kHalf),
+                                            glm::vec3(kHalf, kHeight, kHalf), glm::vec3(-kHalf, kHeight, kHalf)};
+    auto irradiance = [&](glm::vec3 p) {
+        double sum = 0.0;
+        for (size_t i = 0; i < 4; ++i) {
+            const glm::dvec3 a = glm::normalize(glm::dvec3(square[i] - p)), b = glm::normalize(glm::dvec3(square[(i + 1) % 4] - p));
+            const glm::dvec3 c = glm::cross(a, b);
+            sum += std::acos(std::clamp(glm::dot(a, b), -1.0, 1.0)) * c.y / glm::length(c);
+        }
+        return kRadiance / 2.0 * std::abs(sum);
+    };
+    double sumRef = 0.0, sumExpected = 0.0, worst = 0.0, peak = 0.0;
+    int pixels = 0;
+    for (int y = 0; y < kSide; ++y)
+        for (int x = 0; x < kSide; ++x) {
+            const glm::vec2 ndc = (glm::vec2(x, y) + 0.5f) / float(kSide) * 2.0f - 1.0f;
+            const glm::vec4 n = inv * glm::vec4(ndc, -1, 1), f = inv * glm::vec4(ndc, 1, 1);
+            const glm::vec3 o = glm::vec3(n) / n.w, d = glm::vec3(f) / f.w - o;
+            if (d.y >= 0.0f) continue;
+            const glm::vec3 p = o + d * (-o.y / d.y);
+            if (std::abs(p.x) > 1.8f || std::abs(p.z) > 1.8f) continue;
+            const double expected = 0.5 / kPi * irradiance(p), got = img.at(x, y)[1];
+            sumRef += got, sumExpected += expected, ++pixels;
+            worst = std::max(worst, std::abs(got - expected));
+            peak = std::max(peak, expected);
+        }
+    INFO(pixels << " pixels on the plate: mean " << sumRef / pixels << " against " << sumExpected / pixels
+                << ", worst pixel off by " << worst / peak * 100 << " % of the peak " << peak);
+    REQUIRE(pixels > 300);
+    CHECK(std::abs(sumRef - sumExpected) < 0.01 * sumExpected);
+    CHECK(worst < 0.05 * peak);
+    WARN("mean " << sumRef / pixels << " against " << sumExpected / pixels << "; worst pixel " << worst / peak * 100 << " % of the peak");
+}

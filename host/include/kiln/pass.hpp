@@ -343,19 +343,22 @@ void forEachRedrawRect(const PassContext& ctx, int width, int height, int grow, 
 }
 
 // Binds the scene's ray-tracing buffers and material textures (SceneView::rayMeshes)
-// for shaders/common/ray_meshes.glsl, and sets its two uniforms in `program` (which
-// must be in use).
+// for shaders/common/ray_meshes.glsl, and sets its uniforms in `program` (which must be
+// in use).
 inline void bindRayMeshes(const SceneView& scene, GLuint program) {
     const RayMeshes& r = scene.rayMeshes;
     const std::pair<unsigned, uint32_t> buffers[] = {
-        {kRayNodeBinding, r.nodes},     {kRayTriangleBinding, r.triangles}, {kRayInstanceBinding, r.instances},
-        {kRayVertexBinding, r.vertices}, {kRaySurfaceBinding, r.surface},    {kRayIndexBinding, r.indices}};
+        {kRayEmitterBinding, r.emitters}, {kRayNodeBinding, r.nodes},       {kRayTriangleBinding, r.triangles},
+        {kRayInstanceBinding, r.instances}, {kRayVertexBinding, r.vertices}, {kRaySurfaceBinding, r.surface},
+        {kRayIndexBinding, r.indices}};
     for (const auto& [binding, buffer] : buffers)
         if (buffer) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding, buffer);
     if (scene.materialTextures[0]) glBindTextureUnit(kRayColorLayersUnit, scene.materialTextures[0]);
     if (scene.materialTextures[1]) glBindTextureUnit(kRayDataLayersUnit, scene.materialTextures[1]);
     glUniform1ui(glGetUniformLocation(program, "u_rayTopRoot"), r.topRoot);
     glUniform1ui(glGetUniformLocation(program, "u_rayInstanceCount"), r.nodes ? r.instanceCount : 0u);
+    glUniform1ui(glGetUniformLocation(program, "u_rayEmitterCount"), r.emitters ? r.emitterCount : 0u);
+    glUniform1f(glGetUniformLocation(program, "u_rayEmittedPower"), r.emittedPower);
 }
 
 }  // namespace kiln

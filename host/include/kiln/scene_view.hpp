@@ -133,18 +133,28 @@ constexpr int sceneCategoryIndex(uint32_t c) {
 // kiln::bindRayMeshes (kiln/pass.hpp). Rebuilt when the placed models change; the
 // moving bodies are not in it (their shapes are exact: a sphere or a round cone placed
 // by its GpuInstance::model).
+//
+// The emitting triangles (a material with emission) are listed apart, in world space,
+// with their cumulative share of the emitted power (area × the material's mean
+// luminance), for next-event estimation: kilnSampleEmitter picks one by power and a
+// point on it uniformly; kilnEmitterDensity gives the same density for a point a path
+// found by itself (multiple importance sampling).
 struct RayMeshes {
     uint32_t nodes = 0, triangles = 0, instances = 0;  // GL buffer names (0: no meshes)
     uint32_t vertices = 0, surface = 0, indices = 0;   // the scene's vertex streams and indices
+    uint32_t emitters = 0;                             // 0: nothing emits
     uint32_t topRoot = 0;                              // the instances' root node
     uint32_t instanceCount = 0;
+    uint32_t emitterCount = 0;
+    float emittedPower = 0.0f;  // Σ area × mean luminance over the emitters
     uint64_t triangleCount = 0;
 };
-// Shader storage bindings of ray_meshes.glsl (with the instances' at 0, seven of the eight
-// OpenGL 4.5 guarantees a compute shader: 1 is left to the pass), and the texture units of
-// its material lookups (cut-outs, and the shader's own reads through kiln_rayColorLayers).
-inline constexpr unsigned kRayNodeBinding = 2, kRayTriangleBinding = 3, kRayInstanceBinding = 4,
-                          kRayVertexBinding = 5, kRaySurfaceBinding = 6, kRayIndexBinding = 7;
+// Shader storage bindings of ray_meshes.glsl (with the instances' at 0, the eight OpenGL
+// 4.5 guarantees a compute shader), and the texture units of its material lookups
+// (cut-outs, and the shader's own reads through kiln_rayColorLayers).
+inline constexpr unsigned kRayEmitterBinding = 1, kRayNodeBinding = 2, kRayTriangleBinding = 3,
+                          kRayInstanceBinding = 4, kRayVertexBinding = 5, kRaySurfaceBinding = 6,
+                          kRayIndexBinding = 7;
 inline constexpr unsigned kRayColorLayersUnit = 12, kRayDataLayersUnit = 13;
 
 struct SceneView {
