@@ -65,6 +65,16 @@ float kilnRayBoxEntry(vec3 o, vec3 invD, vec3 lo, vec3 hi, float tMin, float tMa
     return enter <= leave ? enter : 1e30;
 }
 
+// The children of an interior node that the ray (o, 1/d) enters before tMax, nearest
+// first in `near`, the other in `far`: how many (0, 1 or 2).
+int kilnRayChildren(KilnRayNode n, vec3 o, vec3 invD, float tMin, float tMax, out uint near, out uint far) {
+    near = n.first, far = n.first + 1u;
+    float tn = kilnRayBoxEntry(o, invD, kiln_rayNodes[near].lo, kiln_rayNodes[near].hi, tMin, tMax);
+    float tf = kilnRayBoxEntry(o, invD, kiln_rayNodes[far].lo, kiln_rayNodes[far].hi, tMin, tMax);
+    if (tf < tn) { uint s = near; near = far; far = s; float f = tn; tn = tf; tf = f; }
+    return tn < tMax ? (tf < tMax ? 2 : 1) : 0;
+}
+
 uvec3 kilnRayTriangleVertices(KilnRayInstance inst, uint triangle) {
     uint f = kiln_rayTriangles[triangle].firstIndex;
     return uvec3(kiln_rayIndices[f], kiln_rayIndices[f + 1u], kiln_rayIndices[f + 2u]) + inst.baseVertex;
@@ -98,12 +108,10 @@ bool kilnTraceMeshes(vec3 o, vec3 d, float tMin, float tMax, out KilnMeshHit hit
     while (true) {
         KilnRayNode n = kiln_rayNodes[node];
         if (n.count == 0u) {
-            uint a = n.first, b = n.first + 1u;
-            float ta = kilnRayBoxEntry(o, invD, kiln_rayNodes[a].lo, kiln_rayNodes[a].hi, tMin, hit.t);
-            float tb = kilnRayBoxEntry(o, invD, kiln_rayNodes[b].lo, kiln_rayNodes[b].hi, tMin, hit.t);
-            if (tb < ta) { uint s = a; a = b; b = s; float f = ta; ta = tb; tb = f; }
-            if (ta < hit.t) {
-                if (tb < hit.t && top < 48) stack[top++] = b;
+            uint a, b;
+            int entered = kilnRayChildren(n, o, invD, tMin, hit.t, a, b);
+            if (entered > 0) {
+                if (entered > 1 && top < 48) stack[top++] = b;
                 node = a;
                 continue;
             }
@@ -122,12 +130,10 @@ bool kilnTraceMeshes(vec3 o, vec3 d, float tMin, float tMax, out KilnMeshHit hit
                 while (true) {
                     KilnRayNode mn = kiln_rayNodes[m];
                     if (mn.count == 0u) {
-                        uint a = mn.first, b = mn.first + 1u;
-                        float ta = kilnRayBoxEntry(lo, linvD, kiln_rayNodes[a].lo, kiln_rayNodes[a].hi, tMin, hit.t);
-                        float tb = kilnRayBoxEntry(lo, linvD, kiln_rayNodes[b].lo, kiln_rayNodes[b].hi, tMin, hit.t);
-                        if (tb < ta) { uint s = a; a = b; b = s; float f = ta; ta = tb; tb = f; }
-                        if (ta < hit.t) {
-                            if (tb < hit.t && innerTop < 48) inner[innerTop++] = b;
+                        uint a, b;
+                        int entered = kilnRayChildren(mn, lo, linvD, tMin, hit.t, a, b);
+                        if (entered > 0) {
+                            if (entered > 1 && innerTop < 48) inner[innerTop++] = b;
                             m = a;
                             continue;
                         }
