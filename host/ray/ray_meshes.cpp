@@ -1,5 +1,7 @@
 #include "ray/ray_meshes.hpp"
 
+#include <algorithm>
+
 #include <glm/gtc/matrix_inverse.hpp>
 
 namespace kiln::ray {
@@ -17,7 +19,81 @@ uint32_t appendNodes(std::vector<BvhNode>& nodes, const Bvh& bvh, uint32_t leafB
     return base;
 }
 
+// The slab test: where the ray enters the box within (tMin, tMax), or tMax if it misses.
+float boxEntry(glm::vec3 o, glm::vec3 invD, const BvhNode& n, float tMin, float tMax) {
+    const glm::vec3 a = (n.lo - o) * invD, b = (n.hi - o) * invD;
+    const glm::vec3 near = glm::min(a, b), far = glm::max(a, b);
+    const float enter = std::max(std::max(near.x, near.y), std::max(near.z, tMin));
+    const float leave = std::min(std::min(far.x, far.y), std::min(far.z, tMax));
+    return enter <= leave ? enter : tMax;
+}
+
+// Visits the leaves of the hierarchy at `root` whose boxes the ray enters before `tMax()`
+// (read again after each leaf, as hits shorten it), nearer children first.
+template <class Leaf, class Limit>
+void walk(const std::vector<BvhNode>& nodes, uint32_t root, glm::vec3 o, glm::vec3 d, Limit tMax, Leaf leaf) {
+    const glm::vec3 invD = 1.0f / d;
+    if (boxEntry(o, invD, nodes[root], 0.0f, tMax()) >= tMax()) return;
+    std::vector<uint32_t> stack;
+    uint32_t node = root;
+    while (true) {
+        const BvhNode& n = nodes[node];
+        if (n.count == 0) {
+            const float ta = boxEntry(o, invD, nodes[n.first], 0.0f, tMax());
+            const float tb = boxEntry(o, invD, nodes[n.first + 1], 0.0f, tMax());
+            const bool inA = ta < tMax(), inB = tb < tMax();
+            if (inA || inB) {
+                const bool aFirst = inA && (!inB || ta <= tb);
+                if (inA && inB) stack.push_back(aFirst ? n.first + 1 : n.first);
+                node = aFirst ? n.first : n.first + 1;
+                continue;
+            }
+        } else {
+            leaf(n);
+        }
+        if (stack.empty()) return;
+        node = stack.back();
+        stack.pop_back();
+    }
+}
+
 }  // namespace
+
+RayHit RayMeshData::nearestHit(glm::vec3 o, glm::vec3 d, float tMax) const {
+    RayHit hit;
+    hit.t = tMax;
+    if (instances_.empty()) return hit;
+    auto limit = [&] { return hit.t; };
+    walk(nodes_, topRoot_, o, d, limit, [&](const BvhNode& top) {
+        for (uint32_t k = top.first; k < top.first + top.count; ++k) {
+            const RayInstance& ri = instances_[k];
+            const glm::vec4 o1(o, 1.0f), d0(d, 0.0f);
+            const glm::vec3 lo(glm::dot(ri.worldToLocal[0], o1), glm::dot(ri.worldToLocal[1], o1),
+                               glm::dot(ri.worldToLocal[2], o1));
+            const glm::vec3 ld(glm::dot(ri.worldToLocal[0], d0), glm::dot(ri.worldToLocal[1], d0),
+                               glm::dot(ri.worldToLocal[2], d0));
+            walk(nodes_, ri.root, lo, ld, limit, [&](const BvhNode& leaf) {
+                for (uint32_t t = leaf.first; t < leaf.first + leaf.count; ++t) {
+                    const RayTriangle& tri = triangles_[t];
+                    const glm::vec3 p = glm::cross(ld, tri.e2);
+                    const float det = glm::dot(tri.e1, p);
+                    if (std::abs(det) < 1e-20f || (ri.twoSided == 0 && det < 0.0f)) continue;
+                    const float inv = 1.0f / det;
+                    const glm::vec3 s = lo - tri.v0;
+                    const float u = glm::dot(s, p) * inv;
+                    if (u < 0.0f || u > 1.0f) continue;
+                    const glm::vec3 q = glm::cross(s, tri.e1);
+                    const float v = glm::dot(ld, q) * inv;
+                    if (v < 0.0f || u + v > 1.0f) continue;
+                    const float tt = glm::dot(tri.e2, q) * inv;
+                    if (tt <= 0.0f || tt >= hit.t) continue;
+                    hit = {tt, k, t, {u, v}};
+                }
+            });
+        }
+    });
+    return hit;
+}
 
 void RayMeshData::addMesh(const RayMeshSource& mesh) {
     nodes_.resize(meshNodes_);  // a top level built before no longer holds

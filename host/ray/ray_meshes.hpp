@@ -4,6 +4,7 @@
 // renderer uploads it (SceneView::rayMeshes).
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -65,6 +66,15 @@ struct RayInstanceSource {
     float emitted = 0.0f;  // the material's mean emitted luminance (0: it gives no light)
 };
 
+// The nearest triangle a ray meets (RayMeshData::nearestHit).
+struct RayHit {
+    float t = INFINITY;
+    uint32_t instance = UINT32_MAX;  // into RayMeshData::instances()
+    uint32_t triangle = 0;           // into RayMeshData::triangles()
+    glm::vec2 barycentric{0.0f};     // of v0 + u·e1 + v·e2
+    bool found() const { return instance != UINT32_MAX; }
+};
+
 class RayMeshData {
 public:
     // Adds a mesh's hierarchy; meshes are numbered in the order they are added.
@@ -81,6 +91,11 @@ public:
     // The top level's root in nodes(), valid when instances() is not empty.
     uint32_t topRoot() const { return topRoot_; }
     size_t meshCount() const { return meshRoots_.size(); }
+    // The nearest triangle along o + t·d for t in (0, tMax), found as ray_meshes.glsl
+    // finds it (the same walk and triangle test; a one-sided instance's back faces are
+    // not hit). Alpha cut-outs are not honoured: the CPU holds no textures. For picking
+    // what a pixel shows, and for checking the GPU's hits.
+    RayHit nearestHit(glm::vec3 origin, glm::vec3 direction, float tMax = INFINITY) const;
 
 private:
     std::vector<BvhNode> nodes_;  // every mesh's hierarchy, then the top level's

@@ -1,7 +1,7 @@
 // The ray tracing hierarchies (host/ray): every triangle in one leaf, every box holding
 // what lies below it, and the nearest hit found through both levels equal to testing
-// every triangle of every instance — the walk here is the shaders' (ray_meshes.glsl):
-// interior children at first and first + 1, leaves' primitives in order.
+// every triangle of every instance — through RayMeshData::nearestHit, the walk and triangle
+// test of the shaders (ray_meshes.glsl) on the CPU.
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -58,59 +58,17 @@ float hitTriangle(glm::vec3 o, glm::vec3 d, glm::vec3 v0, glm::vec3 e1, glm::vec
     return t > 0.0f && t < tMax ? t : -1.0f;
 }
 
-bool boxHit(glm::vec3 o, glm::vec3 d, const BvhNode& n, float tMax) {
-    const glm::vec3 inv = 1.0f / d;
-    const glm::vec3 a = (n.lo - o) * inv, b = (n.hi - o) * inv;
-    const glm::vec3 near = glm::min(a, b), far = glm::max(a, b);
-    const float enter = std::max(std::max(near.x, near.y), std::max(near.z, 0.0f));
-    const float leave = std::min(std::min(far.x, far.y), std::min(far.z, tMax));
-    return enter <= leave;
-}
-
 struct Found {
     float t = INFINITY;
     uint32_t instance = UINT32_MAX;  // RayInstance::instance
     uint32_t firstIndex = 0;         // the triangle's
 };
 
-// Both levels, as the shader walks them.
+// Both levels, as RayMeshData::nearestHit walks them (the shaders' walk on the CPU).
 Found traceHierarchy(const RayMeshData& data, glm::vec3 o, glm::vec3 d) {
-    Found f;
-    if (data.instances().empty()) return f;
-    const auto& nodes = data.nodes();
-    std::vector<uint32_t> stack{data.topRoot()};
-    while (!stack.empty()) {
-        const BvhNode n = nodes[stack.back()];
-        stack.pop_back();
-        if (!boxHit(o, d, n, f.t)) continue;
-        if (n.count == 0) {
-            stack.push_back(n.first), stack.push_back(n.first + 1);
-            continue;
-        }
-        for (uint32_t k = n.first; k < n.first + n.count; ++k) {
-            const RayInstance& ri = data.instances()[k];
-            const glm::vec3 lo(glm::dot(ri.worldToLocal[0], glm::vec4(o, 1)), glm::dot(ri.worldToLocal[1], glm::vec4(o, 1)),
-                               glm::dot(ri.worldToLocal[2], glm::vec4(o, 1)));
-            const glm::vec3 ld(glm::dot(glm::vec3(ri.worldToLocal[0]), d), glm::dot(glm::vec3(ri.worldToLocal[1]), d),
-                               glm::dot(glm::vec3(ri.worldToLocal[2]), d));
-            std::vector<uint32_t> inner{ri.root};
-            while (!inner.empty()) {
-                const BvhNode m = nodes[inner.back()];
-                inner.pop_back();
-                if (!boxHit(lo, ld, m, f.t)) continue;
-                if (m.count == 0) {
-                    inner.push_back(m.first), inner.push_back(m.first + 1);
-                    continue;
-                }
-                for (uint32_t t = m.first; t < m.first + m.count; ++t) {
-                    const RayTriangle& tri = data.triangles()[t];
-                    const float h = hitTriangle(lo, ld, tri.v0, tri.e1, tri.e2, f.t);
-                    if (h > 0.0f) f = {h, ri.instance, tri.firstIndex};
-                }
-            }
-        }
-    }
-    return f;
+    const RayHit h = data.nearestHit(o, d);
+    if (!h.found()) return {};
+    return {h.t, data.instances()[h.instance].instance, data.triangles()[h.triangle].firstIndex};
 }
 
 }  // namespace
@@ -245,4 +203,10 @@ TEST_CASE("an instance of a mesh without triangles is left out of the top level"
     CHECK(data.instances()[0].instance == 6);
     const Found f = traceHierarchy(data, {0.2f, 0.2f, 1.0f}, {0, 0, -1});
     CHECK(f.t == Approx(1.0f));
+    // One-sided: from behind the winding the triangle is not there; two-sided it is.
+    CHECK(std::isinf(traceHierarchy(data, {0.2f, 0.2f, -1.0f}, {0, 0, 1}).t));
+    const std::vector<RayInstanceSource> twoSided = {{1, glm::mat4(1.0f), 6, 0, true}};
+    data.setInstances(twoSided);
+    CHECK(traceHierarchy(data, {0.2f, 0.2f, -1.0f}, {0, 0, 1}).t == Approx(1.0f));
+    CHECK(data.nearestHit({0.2f, 0.2f, -1.0f}, {0, 0, 1}, 0.5f).found() == false);  // beyond tMax
 }
