@@ -9,6 +9,8 @@
 //   radiance  linear HDR radiance, before bloom and tonemapping (compare composite.hdr)
 //   direct    emission seen by the camera plus the lamp's light on the first surface:
 //             what composite computes directly; radiance − direct is the indirect part
+// and (R32F) rays: the rays traced for each pixel so far — path segments and shadow rays —
+// the reference's cost, per pixel (exact while under 2²⁴ a pixel).
 //
 // A frame dispatches the picture in bands of rows until its paths are added or its
 // `budget_ms` is spent; the next frame goes on from the band where it stopped.
@@ -33,6 +35,8 @@ public:
         d.output({.name = "radiance", .format = Format::RGBA32F, .doc = "mean radiance; a = samples per pixel"})
             .output({.name = "direct", .format = Format::RGBA32F,
                      .doc = "emission + the lamp's direct light on the first surface; a = samples"})
+            .output({.name = "rays", .format = Format::R32F,
+                     .doc = "rays traced for the pixel so far (path segments and shadow rays): where the cost is"})
             .param(intParam("samples_per_frame", 1, 1, 256, "paths per pixel added each frame"))
             .param(intParam("max_samples", 4096, 1, 1 << 20, "stop accumulating at this many paths per pixel"))
             .param(intParam("max_bounces", 16, 1, 256, "path length limit (Russian roulette ends most paths sooner)"))
@@ -79,6 +83,7 @@ public:
         kiln::bindRayMeshes(scene, program);
         kiln::gl::bindImage(program, "u_radiance", radiance.id, 0, false, GL_READ_WRITE, GL_RGBA32F);
         kiln::gl::bindImage(program, "u_direct", direct.id, 0, false, GL_READ_WRITE, GL_RGBA32F);
+        kiln::gl::bindImage(program, "u_rays", ctx.output("rays").id, 0, false, GL_READ_WRITE, GL_R32F);
         // A few paths per dispatch: llvmpipe silently ends a shader loop after 65 535
         // iterations (counted across the nesting), which dropped every path beyond
         // ~215 in one invocation of the analytic scene; 8 per dispatch stays far below.

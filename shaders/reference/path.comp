@@ -24,6 +24,7 @@ layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(binding = 0, rgba32f) uniform image2D u_radiance;
 layout(binding = 1, rgba32f) uniform image2D u_direct;
+layout(binding = 2, r32f) uniform image2D u_rays;
 
 uniform uint u_seed;
 uniform int u_sampleBase;     // paths already in the mean
@@ -312,4 +313,6 @@ void main() {
     vec4 meanDirect = u_sampleBase == 0 ? vec4(0.0) : imageLoad(u_direct, pixel);
     imageStore(u_radiance, pixel, vec4((meanTotal.rgb * before + sumTotal) / after, after));
     imageStore(u_direct, pixel, vec4((meanDirect.rgb * before + sumDirect) / after, after));
+    float raysBefore = u_sampleBase == 0 ? 0.0 : imageLoad(u_rays, pixel).r;
+    imageStore(u_rays, pixel, vec4(raysBefore + float(g_rays)));
 }

@@ -81,7 +81,10 @@ float roundConeHit(vec3 o, vec3 d, float tMin, out vec3 normal) {
     return best;
 }
 
+uint g_rays = 0u;  // rays this invocation traced (the pass's `rays` output)
+
 Hit traceScene(vec3 o, vec3 d, float tMin) {
+    ++g_rays;
     Hit h = Hit(kNoHit, vec3(0.0), -1, false, KilnMeshHit(0.0, 0u, 0u, vec2(0.0)));
     for (int i = u_first[kBox]; i < u_first[kBox] + u_count[kBox]; ++i) {
         mat4 m = kiln_instances[i].model;

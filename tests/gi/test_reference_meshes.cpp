@@ -209,7 +209,7 @@ TEST_CASE("reference: the box's walls as glTF triangles equal the same walls as 
     CHECK(std::abs(mean(c) - mean(a)) < 0.02 * mean(a));
 }
 
-TEST_CASE("reference: a directional light on a glTF plate gives E·ρ/π, and its shadow through the BVH is black",
+TEST_CASE("reference: a directional light on a glTF plate gives E·ρ/π, its shadow through the BVH is black, its rays counted",
           "[gi][reference][gltf]") {
     // A 4 m plate (albedo 0.5) at y = 0 under a sun of 3 lux shining straight down, and a
     // black 0.5 m square 0.5 m above it at x = 0.5. One light, picked every time, and no
@@ -255,6 +255,18 @@ TEST_CASE("reference: a directional light on a glTF plate gives E·ρ/π, and it
     const glm::ivec2 shadow = pixel({0.5f, 0.0f, 0.0f});
     INFO("in the shadow: " << radiance.at(shadow.x, shadow.y)[0]);
     CHECK(radiance.at(shadow.x, shadow.y)[0] == 0.0f);
+
+    // The rays output counts what each pixel cost: where the camera sees past the plate,
+    // one ray a path; on the lit plate far from the square, the camera's ray, the shadow
+    // ray to the sun and the bounce that escapes (roulette starts at bounce 3) — three,
+    // and a few more for the rare bounce that meets the square.
+    const FloatImage rays = rig.image("reference", "rays");
+    INFO("rays at the top row " << rays.at(kSide / 2, kSide - 1)[0]);
+    CHECK(rays.at(kSide / 2, kSide - 1)[0] == 8.0f);
+    const glm::ivec2 far = pixel({-1.0f, 0, -1.0f});
+    INFO("rays on the plate " << rays.at(far.x, far.y)[0]);
+    CHECK(rays.at(far.x, far.y)[0] >= 3 * 8.0f);
+    CHECK(rays.at(far.x, far.y)[0] <= 4 * 8.0f);
 }
 
 TEST_CASE("reference vs an independent renderer: Embree on the CPU agrees on a room nobody tuned, within the noise",
