@@ -5,6 +5,7 @@
 //   kiln-bench-quality [--pipeline FILE] [--also FILE]... [--scene FILE] [--time SECONDS]
 //                      [--size WxH] [--spp N] [--frames N] [--repeats R]
 //                      [--sweep PASS.PARAM=V1,V2,...]... [--cartesian] [--out DIR] [--cache DIR]
+//                      [--region NAME=X0,Y0,Z0,X1,Y1,Z1]...
 //
 // 1. Steps the scene to --time and freezes it.
 // 2. The reference (passes/reference) at --spp paths per pixel, rendered as two
@@ -25,8 +26,9 @@
 //    against the reference: RMSE, relative MSE, SSIM, PSNR; emitters (pixels the
 //    G-buffer marks emissive) and the pixels next to them masked out. Also the relative MSE of the indirect part
 //    alone (total − direct: the setting run again with composite.indirect_strength 0,
-//    the reference's own `direct` output) and per region of the box (floor, walls,
-//    ceiling, objects; from the G-buffer depth's world position).
+//    the reference's own `direct` output) and per region: in the box floor, walls,
+//    ceiling and objects (from the G-buffer depth's world position); in a scene without
+//    it, its materials (what each pixel's centre ray meets); and each --region box.
 // 4. Bias apart from noise. An error against a path-traced reference includes the
 //    reference's own noise: at a few hundred paths relative MSE and SSIM largely
 //    measure R, not the setting, and every setting looks about as good. The halves
@@ -36,7 +38,7 @@
 //    - noise-corrected relative MSE, total and indirect: the raw figure less that
 //      noise pixel by pixel, an estimate of the error against the converged truth
 //      (slightly negative for a setting closer to the truth than R can tell);
-//    - bias per region (all, floor, walls, ceiling, objects), total and indirect: mean
+//    - bias per region (all, then the regions above), total and indirect: mean
 //      luminance of the setting ÷ that of R, ± one standard deviation of R's noise;
 //    - SSIM only where it means something: the halves' SSIM against each other is
 //      printed; below 0.97 the reference's noise would dominate the structure SSIM
@@ -49,6 +51,7 @@
 //    its own corrected relMSE beside the reference's noise there, and its bias.
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -105,7 +108,36 @@ struct Args {
     bool images = false;     // write each setting's HDR frame and indirect part beside the reference's
     std::string outDir = "bench-out";
     std::string cacheDir;  // empty: outDir/cache
+    std::vector<std::string> regions;  // NAME=X0,Y0,Z0,X1,Y1,Z1: world boxes with figures of their own
 };
+
+// A --region: the pixels whose surface lies in a world-space box.
+struct WorldRegion {
+    std::string name;
+    glm::vec3 lo, hi;
+};
+
+// NAME=X0,Y0,Z0,X1,Y1,Z1 (either corner first); false with `error` set.
+bool parseRegion(const std::string& text, WorldRegion& region, std::string& error) {
+    const size_t eq = text.find('=');
+    if (eq == 0 || eq == std::string::npos) return error = "expected NAME=X0,Y0,Z0,X1,Y1,Z1, got '" + text + "'", false;
+    region.name = text.substr(0, eq);
+    float v[6];
+    std::istringstream in(text.substr(eq + 1));
+    for (int i = 0; i < 6; ++i) {
+        char comma = ',';
+        if (!(in >> v[i]) || (i < 5 && (!(in >> comma) || comma != ','))) break;
+        if (i == 5) {
+            in >> std::ws;
+            if (!in.eof()) break;
+            region.lo = glm::min(glm::vec3(v[0], v[1], v[2]), glm::vec3(v[3], v[4], v[5]));
+            region.hi = glm::max(glm::vec3(v[0], v[1], v[2]), glm::vec3(v[3], v[4], v[5]));
+            return true;
+        }
+    }
+    return error = region.name + ": expected six numbers X0,Y0,Z0,X1,Y1,Z1 after '=', got '" + text.substr(eq + 1) + "'",
+           false;
+}
 
 [[noreturn]] void usageError(const std::string& message) {
     std::fprintf(stderr, "kiln-bench-quality: error: %s (see kiln-bench-quality --help)\n", message.c_str());
@@ -140,8 +172,16 @@ Args parseArgs(int argc, char** argv) {
     app.add_flag("--images", args.images, "also write OUT/images/: each setting's HDR frame and indirect part, and the reference's");
     app.add_option("--out", args.outDir, "where the CSV, plot and images go (default bench-out)")->type_name("DIR");
     app.add_option("--cache", args.cacheDir, "where references are cached (default OUT/cache)")->type_name("DIR");
+    app.add_option("--region", args.regions,
+                   "a world-space box whose pixels get figures of their own, e.g. dark_room=0,0,-2,4,3,2 (repeatable)")
+        ->type_name("NAME=X0,Y0,Z0,X1,Y1,Z1");
     if (const std::optional<int> exitNow = cli::parse(app, argc, argv)) std::exit(*exitNow);
     if (args.spp % 2) std::exit(cli::usageError(app, "--spp " + std::to_string(args.spp) + ": expected an even count (two halves of N/2 paths)"));
+    for (const std::string& text : args.regions) {
+        WorldRegion region;
+        std::string error;
+        if (!parseRegion(text, region, error)) usageError("--region " + error);
+    }
     if (args.sweeps.empty()) args.sweeps.assign(std::begin(kDefaultSweeps), std::end(kDefaultSweeps));
     return args;
 }
@@ -205,6 +245,7 @@ struct Reference {
     FloatImage halves[2], halvesIndirect[2], halvesDirect[2];
     FloatImage mean, meanIndirect;  // R = (A + B)/2: what the errors are measured against
     double renderSeconds = 0;       // rendering this run (0: both from the cache)
+    double renderedRays = 0;        // the rays those renders traced (reference.rays summed)
 };
 
 // One half of the reference (radiance and direct), from the cache or rendered now.
@@ -212,7 +253,8 @@ struct Reference {
 // the simulation's state at --time (so a change to the simulation's code is a new
 // reference), the size, the half's path count and seed, and the reference pass's code:
 // its shaders, the shared ones it includes and its module's source.
-bool referenceHalf(app::App& app, const Args& args, int half, FloatImage& out, FloatImage& direct, double& seconds) {
+bool referenceHalf(app::App& app, const Args& args, int half, FloatImage& out, FloatImage& direct, double& seconds,
+                   double& rays) {
     const int seed = kHalfSeeds[half], paths = args.spp / 2;
     const std::string sceneText = slurp(args.scene);
     uint64_t key = fnv1a(sceneText);
@@ -285,16 +327,25 @@ bool referenceHalf(app::App& app, const Args& args, int half, FloatImage& out, F
     fs::create_directories(cache.parent_path());
     if (!writeExr(cache.string(), out, error) || !writeExr(directCache.string(), direct, error)) return fail(error);
     seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    std::printf("%s: %d paths/px in %.1f s (%.0f k paths/s), cached as %s\n", what, paths, seconds,
-                double(paths) * args.width * args.height / seconds / 1000.0, cache.string().c_str());
+    const TextureRef* r = app.runtime().findTexture("reference", "rays");
+    if (!r) return fail("the reference pass produced no rays texture");
+    const FloatImage perPixel = readTexture(r->id, r->target, r->format, r->width, r->height);
+    rays = 0;
+    for (int y = 0; y < perPixel.height; ++y)
+        for (int x = 0; x < perPixel.width; ++x) rays += perPixel.at(x, y)[0];
+    const double pathCount = double(paths) * args.width * args.height;
+    std::printf("%s: %d paths/px in %.1f s (%.0f k paths/s, %.2f M rays/s, %.1f rays a path), cached as %s\n", what,
+                paths, seconds, pathCount / seconds / 1000.0, rays / seconds / 1e6, rays / pathCount,
+                cache.string().c_str());
     return true;
 }
 
 bool loadReference(app::App& app, const Args& args, Reference& ref) {
     for (int half = 0; half < 2; ++half) {
-        double seconds = 0;
-        if (!referenceHalf(app, args, half, ref.halves[half], ref.halvesDirect[half], seconds)) return false;
+        double seconds = 0, rays = 0;
+        if (!referenceHalf(app, args, half, ref.halves[half], ref.halvesDirect[half], seconds, rays)) return false;
         ref.renderSeconds += seconds;
+        ref.renderedRays += rays;
         ref.halvesIndirect[half] = metrics::difference(ref.halves[half], ref.halvesDirect[half]);
     }
     ref.mean = metrics::average(ref.halves[0], ref.halves[1]);
@@ -302,41 +353,118 @@ bool loadReference(app::App& app, const Args& args, Reference& ref) {
     return true;
 }
 
-// Parts of the box a pixel shows, from the world position of its depth: the box is
-// [-1, 1]³ (the sim's walls), everything inside it an object (tumblers, balls).
-enum Region { kFloor, kWalls, kCeiling, kObjects, kRegionCount };
-const char* const kRegionNames[kRegionCount] = {"floor", "walls", "ceiling", "objects"};
+// The parts of the picture the figures are given for, each a mask over the counted
+// pixels: "all", the scene's regions (each pixel in at most one), then the --region
+// boxes (which may overlap them and each other). In the box: floor, walls, ceiling and
+// objects, from the world position of the G-buffer's depth. A scene without the box:
+// its materials, by what each pixel's centre ray meets first (the CPU walk of the
+// reference's BVH), the eight that cover most of the picture named, the rest together.
+struct Parts {
+    std::vector<std::string> names;
+    std::vector<metrics::Mask> masks;
+    size_t sceneRegions = 0;  // names[1 .. 1 + sceneRegions) are the scene's
+    metrics::Mask domeRing;   // the ceiling within 0.5 m of the lamp's axis (box scenes)
+};
 
-// Also marks `domeRing`: the ceiling within 0.5 m of the lamp's vertical axis, where the
-// lamp's near field is (the issue-22 diagnosis counted 708 such pixels at 256²).
-std::vector<int> regionsOf(app::App& app, const FloatImage& depth, metrics::Mask& domeRing) {
-    const glm::vec2 lampAxis(app.scene().look().lampCentre.x, app.scene().look().lampCentre.z);
-    domeRing.assign(size_t(depth.width) * depth.height, 0);
+constexpr int kMaterialRegions = 8;
+constexpr double kMaterialRegionShare = 0.02;  // of the drawn pixels, to be named
+
+Parts partsOf(app::App& app, const Args& args, const FloatImage& depth, const metrics::Mask& counted) {
+    const size_t pixels = size_t(depth.width) * depth.height;
     const glm::mat4 invViewProj = glm::inverse(app.camera().projection(float(depth.width) / float(depth.height)) *
                                                app.camera().view());
-    std::vector<int> region(size_t(depth.width) * depth.height, -1);
-    constexpr float kOnWall = 0.995f;  // within 5 mm of a wall plane
-    for (int y = 0; y < depth.height; ++y)
-        for (int x = 0; x < depth.width; ++x) {
-            const float d = depth.at(x, y)[0];
-            if (d >= 1.0f) continue;  // nothing drawn
-            glm::vec4 p = invViewProj * glm::vec4((x + 0.5f) / depth.width * 2 - 1, (y + 0.5f) / depth.height * 2 - 1, d * 2 - 1, 1);
-            p /= p.w;
-            int r = kObjects;
-            if (p.y < -kOnWall) r = kFloor;
-            else if (p.y > kOnWall) {
-                r = kCeiling;
-                domeRing[size_t(y) * depth.width + x] = glm::distance(glm::vec2(p.x, p.z), lampAxis) < 0.5f;
+    auto unproject = [&](int x, int y, float ndcZ) {
+        glm::vec4 p = invViewProj * glm::vec4((x + 0.5f) / depth.width * 2 - 1, (y + 0.5f) / depth.height * 2 - 1, ndcZ, 1);
+        return glm::vec3(p) / p.w;
+    };
+    Parts parts;
+    parts.domeRing.assign(pixels, 0);
+    std::vector<int> region(pixels, -1);
+    std::vector<std::string> names;
+    if (app.scene().look().walls) {
+        names = {"floor", "walls", "ceiling", "objects"};
+        const glm::vec2 lampAxis(app.scene().look().lampCentre.x, app.scene().look().lampCentre.z);
+        constexpr float kOnWall = 0.995f;  // within 5 mm of a wall plane
+        for (int y = 0; y < depth.height; ++y)
+            for (int x = 0; x < depth.width; ++x) {
+                const float d = depth.at(x, y)[0];
+                if (d >= 1.0f) continue;  // nothing drawn
+                const glm::vec3 p = unproject(x, y, d * 2 - 1);
+                const size_t i = size_t(y) * depth.width + x;
+                int r = 3;
+                if (p.y < -kOnWall) r = 0;
+                else if (p.y > kOnWall) {
+                    r = 2;
+                    parts.domeRing[i] = glm::distance(glm::vec2(p.x, p.z), lampAxis) < 0.5f;
+                }
+                else if (std::abs(p.x) > kOnWall || p.z < -kOnWall) r = 1;
+                region[i] = r;
             }
-            else if (std::abs(p.x) > kOnWall || p.z < -kOnWall) r = kWalls;
-            region[size_t(y) * depth.width + x] = r;
+    } else {
+        const ray::RayMeshData& rays = app.renderer().rayMeshData();
+        std::map<std::string, int> index;
+        std::vector<std::string> seen;
+        std::vector<size_t> count;
+        size_t drawn = 0;
+        for (int y = 0; y < depth.height; ++y)
+            for (int x = 0; x < depth.width; ++x) {
+                if (depth.at(x, y)[0] >= 1.0f) continue;
+                ++drawn;
+                const glm::vec3 o = unproject(x, y, -1.0f);
+                const ray::RayHit hit = rays.nearestHit(o, unproject(x, y, 1.0f) - o);
+                if (!hit.found()) continue;
+                const std::string name = app.renderer().materialNameOf(rays.instances()[hit.instance].instance);
+                auto [it, added] = index.try_emplace(name, int(seen.size()));
+                if (added) seen.push_back(name), count.push_back(0);
+                ++count[size_t(it->second)];
+                region[size_t(y) * depth.width + x] = it->second;
+            }
+        std::vector<int> byCount(seen.size());
+        for (size_t k = 0; k < byCount.size(); ++k) byCount[k] = int(k);
+        std::stable_sort(byCount.begin(), byCount.end(), [&](int a, int b) { return count[size_t(a)] > count[size_t(b)]; });
+        std::vector<int> renamed(seen.size(), -1);
+        bool rest = false;
+        for (int k : byCount) {
+            if (int(names.size()) < kMaterialRegions && count[size_t(k)] >= kMaterialRegionShare * double(drawn)) {
+                renamed[size_t(k)] = int(names.size());
+                names.push_back(seen[size_t(k)]);
+            } else {
+                rest = true;
+            }
         }
-    return region;
+        const int restIndex = int(names.size());
+        if (rest) names.push_back("other materials");
+        for (int& r : region)
+            if (r >= 0) r = renamed[size_t(r)] >= 0 ? renamed[size_t(r)] : restIndex;
+    }
+    parts.names.push_back("all");
+    parts.masks.push_back(counted);
+    for (size_t k = 0; k < names.size(); ++k) {
+        metrics::Mask m = counted;
+        for (size_t i = 0; i < pixels; ++i) m[i] = m[i] && region[i] == int(k);
+        parts.names.push_back(names[k]);
+        parts.masks.push_back(std::move(m));
+    }
+    parts.sceneRegions = names.size();
+    for (const std::string& text : args.regions) {
+        WorldRegion box;
+        std::string error;
+        parseRegion(text, box, error);  // checked with the arguments
+        metrics::Mask m(pixels, 0);
+        for (int y = 0; y < depth.height; ++y)
+            for (int x = 0; x < depth.width; ++x) {
+                const size_t i = size_t(y) * depth.width + x;
+                const float d = depth.at(x, y)[0];
+                if (d >= 1.0f || !counted[i]) continue;
+                const glm::vec3 p = unproject(x, y, d * 2 - 1);
+                m[i] = glm::all(glm::greaterThanEqual(p, box.lo)) && glm::all(glm::lessThanEqual(p, box.hi));
+            }
+        parts.names.push_back(box.name);
+        parts.masks.push_back(std::move(m));
+    }
+    for (size_t i = 0; i < pixels; ++i) parts.domeRing[i] = parts.domeRing[i] && counted[i];
+    return parts;
 }
-
-// The bias figures look at the whole counted image and at each region in turn.
-constexpr int kPartCount = kRegionCount + 1;  // [0] all, [1 + region]
-const char* const kPartNames[kPartCount] = {"all", "floor", "walls", "ceiling", "objects"};
 
 struct Result {
     std::string label;
@@ -344,11 +472,13 @@ struct Result {
     double totalMs = 0;
     metrics::Errors errors;  // against R
     double indirectRelMse = 0;
-    double regionRelMse[kRegionCount] = {};
+    std::vector<std::string> partNames;  // Parts::names
+    size_t sceneRegions = 0;
+    std::vector<double> partRelMse;      // per part, against R
     // Less the reference's own noise: estimates of the error against the truth.
     double relMseCorrected = 0, indirectRelMseCorrected = 0;
     // Mean luminance of the setting ÷ that of R, total, indirect and direct, per part.
-    metrics::RatioWithUncertainty meanRatio[kPartCount], indirectRatio[kPartCount], directRatio[kPartCount];
+    std::vector<metrics::RatioWithUncertainty> meanRatio, indirectRatio, directRatio;
     // The ceiling around the dome: corrected relMSE, the reference's own noise there, bias.
     double ringRelMseCorrected = 0, ringNoise = 0;
     int ringPixels = 0;
@@ -390,13 +520,15 @@ void domeRingFigures(const FloatImage& image, const Reference& ref, const metric
 // the direct part's bias (the frame without it: the lamp's light and what is seen glowing).
 void indirectFigures(const FloatImage& indirect, const FloatImage& direct, const Reference& ref,
                      const metrics::Mask& mask, const std::vector<metrics::Mask>& partMask, Result& r) {
+    r.indirectRatio.resize(partMask.size());
+    r.directRatio.resize(partMask.size());
     const FloatImage& indirectA = ref.halvesIndirect[0];
     const FloatImage& indirectB = ref.halvesIndirect[1];
     r.indirectRelMse = metrics::relativeMse(indirect, ref.meanIndirect, mask);
     r.indirectRelMseCorrected = metrics::noiseCorrectedRelativeMse(indirect, indirectA, indirectB, mask);
-    for (int p = 0; p < kPartCount; ++p)
+    for (size_t p = 0; p < partMask.size(); ++p)
         r.indirectRatio[p] = metrics::meanLuminanceRatio(indirect, indirectA, indirectB, partMask[p]);
-    for (int p = 0; p < kPartCount; ++p)
+    for (size_t p = 0; p < partMask.size(); ++p)
         r.directRatio[p] = metrics::meanLuminanceRatio(direct, ref.halvesDirect[0], ref.halvesDirect[1], partMask[p]);
 }
 
@@ -460,18 +592,17 @@ bool score(app::App& app, const Args& args, const std::string& label, const Refe
 
     const TextureRef* depth = app.runtime().findTexture("gbuffer", "depth");
     if (!depth) return fail(label + ": the pipeline has no gbuffer.depth");
-    metrics::Mask ring;
-    const std::vector<int> region =
-        regionsOf(app, readTexture(depth->id, depth->target, depth->format, depth->width, depth->height), ring);
-    for (size_t i = 0; i < ring.size(); ++i) ring[i] = ring[i] && mask[i];
-    domeRingFigures(image, ref, ring, r);
-    std::vector<metrics::Mask> partMask(kPartCount, mask);
-    for (int k = 0; k < kRegionCount; ++k) {
-        metrics::Mask& m = partMask[1 + k];
-        for (size_t i = 0; i < m.size(); ++i) m[i] = m[i] && region[i] == k;
-        r.regionRelMse[k] = metrics::relativeMse(image, ref.mean, m);
+    const Parts parts =
+        partsOf(app, args, readTexture(depth->id, depth->target, depth->format, depth->width, depth->height), mask);
+    domeRingFigures(image, ref, parts.domeRing, r);
+    const std::vector<metrics::Mask>& partMask = parts.masks;
+    r.partNames = parts.names;
+    r.sceneRegions = parts.sceneRegions;
+    r.meanRatio.resize(partMask.size());
+    for (size_t p = 0; p < partMask.size(); ++p) {
+        r.partRelMse.push_back(metrics::relativeMse(image, ref.mean, partMask[p]));
+        r.meanRatio[p] = metrics::meanLuminanceRatio(image, halfA, halfB, partMask[p]);
     }
-    for (int p = 0; p < kPartCount; ++p) r.meanRatio[p] = metrics::meanLuminanceRatio(image, halfA, halfB, partMask[p]);
     // The indirect part: the same frame without composite's indirect term.
     if (!app.runtime().setParam("composite", "indirect_strength", 0.0f, error)) return fail(label + ": " + error);
     app.frame();
@@ -600,41 +731,56 @@ ReferenceFigures referenceFigures(const Reference& ref, const Args& args, const 
 }
 
 // The error table on stdout and quality.csv, one row per setting each.
+// A part's name as a CSV column's: lower case, what is not a letter or digit '_'.
+std::string columnName(const std::string& name) {
+    std::string c;
+    for (char ch : name) c += std::isalnum(static_cast<unsigned char>(ch)) ? char(std::tolower(static_cast<unsigned char>(ch))) : '_';
+    return c;
+}
+
 void writeErrors(const std::vector<Result>& results, bool ssimMeaningful, const std::string& csvPath) {
     std::ofstream csv(csvPath);
+    const std::vector<std::string>& partNames = results.front().partNames;
     csv << "setting,total_gpu_ms,rmse,rel_mse,ssim,psnr,pixels,pareto,rel_mse_indirect";
-    for (const char* name : kRegionNames) csv << ",rel_mse_" << name;
+    for (size_t p = 1; p < partNames.size(); ++p) csv << ",rel_mse_" << columnName(partNames[p]);
     csv << ",rel_mse_corrected,rel_mse_indirect_corrected";
     for (const char* kind : {"mean_ratio_", "indirect_ratio_"})
-        for (const char* part : kPartNames) csv << ',' << kind << part << ',' << kind << part << "_uncertainty";
+        for (const std::string& name : partNames) {
+            const std::string part = columnName(name);
+            csv << ',' << kind << part << ',' << kind << part << "_uncertainty";
+        }
     csv << ",dome_ring_pixels,rel_mse_dome_ring_corrected,ref_noise_dome_ring,mean_ratio_dome_ring,"
            "mean_ratio_dome_ring_uncertainty,pass_ms";
-    for (const char* part : kPartNames) csv << ",direct_ratio_" << part << ",direct_ratio_" << part << "_uncertainty";
+    for (const std::string& name : partNames)
+        csv << ",direct_ratio_" << columnName(name) << ",direct_ratio_" << columnName(name) << "_uncertainty";
     csv << '\n';
-    std::printf("%-44s %9s %9s %9s %9s %7s %7s %9s %9s  %-31s %s\n", "setting", "gpu ms", "RMSE", "relMSE", "corrected",
-                "SSIM", "PSNR", "indirect", "corrected", "relMSE floor/walls/ceil/objects", "front");
+    std::string regionsHeading = "relMSE";
+    for (size_t p = 1; p < partNames.size(); ++p) regionsHeading += (p == 1 ? " " : "/") + partNames[p];
+    std::printf("%-44s %9s %9s %9s %9s %7s %7s %9s %9s %s  %s\n", "setting", "gpu ms", "RMSE", "relMSE", "corrected",
+                "SSIM", "PSNR", "indirect", "corrected", "front", regionsHeading.c_str());
     for (const Result& r : results) {
         char ssimCell[16] = "n/a";
         if (ssimMeaningful) std::snprintf(ssimCell, sizeof ssimCell, "%.4f", r.errors.ssim);
-        std::printf("%-44s %9.2f %9.5f %9.5f %9.5f %7s %7.2f %9.5f %9.5f  %7.4f %7.4f %7.4f %7.4f  %s\n", r.label.c_str(),
-                    r.totalMs, r.errors.rmse, r.errors.relMse, r.relMseCorrected, ssimCell, r.errors.psnr, r.indirectRelMse,
-                    r.indirectRelMseCorrected, r.regionRelMse[0], r.regionRelMse[1], r.regionRelMse[2], r.regionRelMse[3],
-                    r.pareto ? "*" : "");
+        std::printf("%-44s %9.2f %9.5f %9.5f %9.5f %7s %7.2f %9.5f %9.5f %5s ", r.label.c_str(), r.totalMs,
+                    r.errors.rmse, r.errors.relMse, r.relMseCorrected, ssimCell, r.errors.psnr, r.indirectRelMse,
+                    r.indirectRelMseCorrected, r.pareto ? "*" : "");
+        for (size_t p = 1; p < r.partRelMse.size(); ++p) std::printf(" %7.4f", r.partRelMse[p]);
+        std::printf("\n");
         std::string passes;
         for (auto& [id, ms] : r.passMs) passes += (passes.empty() ? "" : " ") + id + "=" + std::to_string(ms);
         csv << '"' << r.label << "\"," << r.totalMs << ',' << r.errors.rmse << ',' << r.errors.relMse << ','
             << (ssimMeaningful ? csvNumber(r.errors.ssim) : "") << ',' << r.errors.psnr << ',' << r.errors.pixels << ','
             << (r.pareto ? 1 : 0) << ',' << r.indirectRelMse;
-        for (double v : r.regionRelMse) csv << ',' << v;
+        for (size_t p = 1; p < r.partRelMse.size(); ++p) csv << ',' << csvNumber(r.partRelMse[p]);
         csv << ',' << r.relMseCorrected << ',' << r.indirectRelMseCorrected;
-        for (const auto* ratios : {r.meanRatio, r.indirectRatio})
-            for (int p = 0; p < kPartCount; ++p)
-                csv << ',' << csvNumber(ratios[p].ratio) << ',' << csvNumber(ratios[p].uncertainty);
+        for (const auto* ratios : {&r.meanRatio, &r.indirectRatio})
+            for (const metrics::RatioWithUncertainty& ratio : *ratios)
+                csv << ',' << csvNumber(ratio.ratio) << ',' << csvNumber(ratio.uncertainty);
         csv << ',' << r.ringPixels << ',' << r.ringRelMseCorrected << ',' << r.ringNoise << ','
             << csvNumber(r.ringRatio.ratio) << ',' << csvNumber(r.ringRatio.uncertainty);
         csv << ",\"" << passes << '"';
-        for (int p = 0; p < kPartCount; ++p)
-            csv << ',' << csvNumber(r.directRatio[p].ratio) << ',' << csvNumber(r.directRatio[p].uncertainty);
+        for (const metrics::RatioWithUncertainty& ratio : r.directRatio)
+            csv << ',' << csvNumber(ratio.ratio) << ',' << csvNumber(ratio.uncertainty);
         csv << '\n';
     }
     std::printf("\n* = on the Pareto front of (GPU ms, corrected relMSE); corrected = less the reference's own noise\n\n");
@@ -644,19 +790,19 @@ void writeErrors(const std::vector<Result>& results, bool ssimMeaningful, const 
 // the ceiling around the dome.
 void printBias(const std::vector<Result>& results) {
     std::printf("bias: mean luminance of the setting ÷ the reference's, ± 1σ of the reference's noise\n");
-    std::printf("%-44s  %-65s %s\n%-44s", "", "total", "indirect", "setting");
-    for (int kind = 0; kind < 2; ++kind) {
-        std::printf(" ");
-        for (const char* part : kPartNames) std::printf(" %12s", part);
-    }
-    std::printf("\n");
-    for (const Result& r : results) {
-        std::printf("%-44s", r.label.c_str());
-        for (const auto* ratios : {r.meanRatio, r.indirectRatio}) {
-            std::printf(" ");
-            for (int p = 0; p < kPartCount; ++p) std::printf(" %s", ratioCell(ratios[p]).c_str());
-        }
+    const std::vector<std::string>& partNames = results.front().partNames;
+    std::vector<int> widths;
+    for (const std::string& name : partNames) widths.push_back(std::max(12, int(name.size())));
+    for (const char* kind : {"total", "indirect"}) {
+        std::printf("\n%-44s", kind);
+        for (size_t p = 0; p < partNames.size(); ++p) std::printf(" %*s", widths[p], partNames[p].c_str());
         std::printf("\n");
+        for (const Result& r : results) {
+            const auto& ratios = std::string(kind) == "total" ? r.meanRatio : r.indirectRatio;
+            std::printf("%-44s", r.label.c_str());
+            for (size_t p = 0; p < ratios.size(); ++p) std::printf(" %*s", widths[p], ratioCell(ratios[p]).c_str());
+            std::printf("\n");
+        }
     }
     if (!results.empty() && results.front().ringPixels > 0) {
         std::printf("\nthe ceiling within 0.5 m of the lamp's axis (%d px; the reference's own relMSE there %.5f):\n",
@@ -689,6 +835,7 @@ nlohmann::json summary(const Args& args, const std::string& device, double scene
         {"ref_noise_rel_mse", figures.noiseFloor},
         {"ref_noise_rel_mse_indirect", figures.noiseFloorIndirect},
         {"reference_render_s", ref.renderSeconds},
+        {"reference_rays_per_s", ref.renderSeconds > 0 ? ref.renderedRays / ref.renderSeconds : NAN},
         {"wall_s", std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count()},
         {"frames", args.frames},
         {"repeats", args.repeats},

@@ -53,6 +53,8 @@ public:
     const Runtime& runtime() const { return runtime_; }
     scene::LiveScene& scene() { return scene_; }
     const scene::LiveScene& scene() const { return scene_; }
+    // The scene's geometry as last uploaded (its CPU side: ray hierarchies, material names).
+    const scene::SceneRenderer& renderer() const { return renderer_; }
     Camera& camera() { return camera_; }
     const Camera& camera() const { return camera_; }
     LiveReload& live() { return live_; }

@@ -91,6 +91,7 @@ void SceneRenderer::buildMeshes() {
     // The placed models: one mesh each of their meshes, and one more for each instance
     // whose transform is no similarity (non-uniform scale, a mirror), baked into it.
     meshInstances_.clear();
+    meshInstanceMaterials_.clear();
     meshGroups_.clear();
     auto addMesh = [&](const model::Mesh& m, const glm::mat4* bake) {
         meshes_.push_back({static_cast<uint32_t>(indices.size()), static_cast<uint32_t>(m.indices.size()),
@@ -120,6 +121,11 @@ void SceneRenderer::buildMeshes() {
     auto twoSided = [](const model::Model& mdl, int material) {
         return material >= 0 && mdl.materials[size_t(material)].doubleSided;
     };
+    auto materialName = [](const model::Model& mdl, int material) {
+        if (material < 0) return std::string("(no material)");
+        const std::string& name = mdl.materials[size_t(material)].name;
+        return name.empty() ? "material " + std::to_string(material) : name;
+    };
     uint32_t materialBase = 0;
     for (const PlacedModel& placed : models_) {
         const model::Model& mdl = *placed.model;
@@ -136,13 +142,16 @@ void SceneRenderer::buildMeshes() {
                 meshGroups_.push_back({baked, 1, twoSided(mdl, mdl.meshes[size_t(inst.mesh)].material)});
                 meshInstances_.push_back(materialInstance(mdl, materialBase, mdl.meshes[size_t(inst.mesh)].material,
                                                           glm::mat4(1.0f)));
+                meshInstanceMaterials_.push_back(materialName(mdl, mdl.meshes[size_t(inst.mesh)].material));
             }
         }
         for (size_t m = 0; m < byMesh.size(); ++m) {
             if (byMesh[m].empty()) continue;
             meshGroups_.push_back({first + uint32_t(m), uint32_t(byMesh[m].size()), twoSided(mdl, mdl.meshes[m].material)});
-            for (const glm::mat4& world : byMesh[m])
+            for (const glm::mat4& world : byMesh[m]) {
                 meshInstances_.push_back(materialInstance(mdl, materialBase, mdl.meshes[m].material, world));
+                meshInstanceMaterials_.push_back(materialName(mdl, mdl.meshes[m].material));
+            }
         }
         materialBase += uint32_t(mdl.materials.size());
     }
@@ -206,6 +215,12 @@ void SceneRenderer::buildRayMeshes(const std::vector<Vertex>& vertices, const st
     upload(rayTriangles_, rayData_.triangles(), "scene.ray_triangles");
     upload(rayInstances_, rayData_.instances(), "scene.ray_instances");
     upload(rayEmitters_, rayData_.emitters(), "scene.ray_emitters");
+}
+
+std::string SceneRenderer::materialNameOf(uint32_t sceneInstance) const {
+    const size_t first = staticInstances_.size();
+    if (sceneInstance < first || sceneInstance - first >= meshInstanceMaterials_.size()) return {};
+    return meshInstanceMaterials_[sceneInstance - first];
 }
 
 kiln::RayMeshes SceneRenderer::rayMeshes() const {

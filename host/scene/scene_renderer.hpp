@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "kiln/gl.hpp"
@@ -115,6 +116,10 @@ public:
     kiln::RayMeshes rayMeshes() const;
     // The same on the CPU (tests and the CPU tracers read it).
     const ray::RayMeshData& rayMeshData() const { return rayData_; }
+    // The name of the material a placed mesh's instance shows (the index is the scene's,
+    // as RayInstance::instance holds it): its glTF name, "material N" when it has none,
+    // "(no material)" for glTF's default; empty for an instance that is not a placed mesh.
+    std::string materialNameOf(uint32_t sceneInstance) const;
     // The texture arrays of SceneView::materialTextures (0 where there are none).
     GLuint materialTexture(int which) const { return which == 0 ? colorLayers_.id() : dataLayers_.id(); }
     // The camera, for the spheres' level of detail and the particles' order: its
@@ -186,6 +191,7 @@ private:
     std::vector<PlacedModel> models_;
     // The instances of kSceneMeshes, grouped by mesh (meshGroups_ in order).
     std::vector<GpuInstance> meshInstances_;
+    std::vector<std::string> meshInstanceMaterials_;  // each one's material name
     struct MeshGroup { uint32_t mesh, instances; bool twoSided; };
     std::vector<MeshGroup> meshGroups_;
     gl::Buffer vertexBuffer_, surfaceBuffer_, indexBuffer_;

@@ -4,6 +4,7 @@
 // usage errors before anything renders.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <sstream>
@@ -118,6 +119,44 @@ TEST_CASE("kiln-bench-quality: a tiny sweep writes one finite CSV row per settin
     CHECK(later.exitCode == 0);
     CHECK(later.out.find("(cached)") == std::string::npos);
     CHECK(later.out.find("cached as " + out + "/cache/") != std::string::npos);
+}
+
+TEST_CASE("kiln-bench-quality on a glTF scene: figures per material and per --region box, and the reference's rays/s",
+          "[integration][bench]") {
+    // The two rooms: no box, so the regions are the materials each pixel's centre ray
+    // meets; a --region over the whole scene holds exactly the counted pixels, so its
+    // figures are the "all" figures to the last digit.
+    const std::string out = std::string(TEST_OUTPUT_DIR) + "/bench-quality-gltf";
+    std::filesystem::remove_all(out);
+    Run r = runProgram(KILN_BENCH_QUALITY,
+                       "--scene scenes/two_rooms.gltf --time 0 --size 32x32 --spp 8 --frames 1 --repeats 1 "
+                       "--sweep composite.pcf=1 --region dark_room=0.09,-0.01,-2.01,4.11,3.01,2.01 "
+                       "--region everything=-100,-100,-100,100,100,100 --out " + out,
+                       300);
+    INFO(r.out << r.err);
+    REQUIRE(r.exitCode == 0);
+    const QualityCsv csv(slurp(out + "/quality.csv"));
+    REQUIRE(csv.rows.size() == 2);
+    for (size_t i = 0; i < csv.rows.size(); ++i) {
+        for (const char* name : {"rel_mse_partition", "rel_mse_plaster", "rel_mse_floor", "rel_mse_dark_room",
+                                 "mean_ratio_partition", "mean_ratio_dark_room", "indirect_ratio_dark_room"}) {
+            INFO(name);
+            CHECK(std::isfinite(csv.number(i, name)));
+            CHECK(csv.number(i, name) > 0.0);
+        }
+        CHECK(csv.number(i, "mean_ratio_everything") == csv.number(i, "mean_ratio_all"));
+        CHECK(csv.number(i, "rel_mse_everything") == Approx(csv.number(i, "rel_mse")).epsilon(1e-9));
+    }
+    CHECK(csv.header.end() == std::find(csv.header.begin(), csv.header.end(), "rel_mse_ceiling"));  // no box words
+    const std::string summary = slurp(out + "/summary.json");
+    const size_t at = summary.find("\"reference_rays_per_s\": ");
+    REQUIRE(at != std::string::npos);
+    CHECK(std::stod(summary.substr(at + 24)) > 0.0);
+    CHECK(r.out.find("M rays/s") != std::string::npos);
+
+    Run bad = runProgram(KILN_BENCH_QUALITY, "--region dark=1,2,3", 60);
+    CHECK(bad.exitCode == 2);
+    CHECK(bad.err.find("--region dark: expected six numbers") != std::string::npos);
 }
 
 TEST_CASE("kiln-bench-quality: a pipeline or scene file it cannot read is a usage error before the reference renders",
