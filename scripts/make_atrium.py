@@ -9,11 +9,10 @@ the file is glTF 2.0 with its buffer embedded, and a camera at eye height.
 
     scripts/make_atrium.py [out.gltf]
 """
-import base64
 import json
-import math
-import struct
 import sys
+
+from gltf_boxes import look_rotation, scene
 
 W, H, D = 37.0, 15.0, 22.0      # outer size: x, y, z
 WALL = 0.4                      # wall, slab and roof thickness
@@ -29,26 +28,6 @@ MATERIALS = {
     "red": (0.70, 0.12, 0.10),
     "blue": (0.12, 0.22, 0.65),
 }
-
-
-def box(lo, hi):
-    """The 24 vertices (4 a face, outward normals) and 36 indices of an axis-aligned box."""
-    (x0, y0, z0), (x1, y1, z1) = lo, hi
-    faces = [
-        ((1, 0, 0), [(x1, y0, z0), (x1, y1, z0), (x1, y1, z1), (x1, y0, z1)]),
-        ((-1, 0, 0), [(x0, y0, z1), (x0, y1, z1), (x0, y1, z0), (x0, y0, z0)]),
-        ((0, 1, 0), [(x0, y1, z0), (x0, y1, z1), (x1, y1, z1), (x1, y1, z0)]),
-        ((0, -1, 0), [(x0, y0, z1), (x0, y0, z0), (x1, y0, z0), (x1, y0, z1)]),
-        ((0, 0, 1), [(x1, y0, z1), (x1, y1, z1), (x0, y1, z1), (x0, y0, z1)]),
-        ((0, 0, -1), [(x0, y0, z0), (x0, y1, z0), (x1, y1, z0), (x1, y0, z0)]),
-    ]
-    positions, normals, indices = [], [], []
-    for n, quad in faces:
-        base = len(positions)
-        positions += quad
-        normals += [n] * 4
-        indices += [base, base + 1, base + 2, base, base + 2, base + 3]
-    return positions, normals, indices
 
 
 def atrium():
@@ -80,71 +59,15 @@ def atrium():
 
 
 def gltf(parts):
-    blob = bytearray()
-    views, accessors, primitives, materials = [], [], [], []
-
-    def view(data, target):
-        while len(blob) % 4:
-            blob.append(0)
-        views.append({"buffer": 0, "byteOffset": len(blob), "byteLength": len(data), "target": target})
-        blob.extend(data)
-        return len(views) - 1
-
-    for m, (name, rgb) in enumerate(MATERIALS.items()):
-        materials.append({"name": name, "pbrMetallicRoughness": {"baseColorFactor": [*rgb, 1.0],
-                                                                  "metallicFactor": 0.0, "roughnessFactor": 0.9}})
-        positions, normals, indices = [], [], []
-        for lo, hi in parts[name]:
-            p, n, i = box(lo, hi)
-            indices += [len(positions) + k for k in i]
-            positions += p
-            normals += n
-        lo = [min(p[k] for p in positions) for k in range(3)]
-        hi = [max(p[k] for p in positions) for k in range(3)]
-        pv = view(b"".join(struct.pack("<3f", *p) for p in positions), 34962)
-        nv = view(b"".join(struct.pack("<3f", *n) for n in normals), 34962)
-        iv = view(b"".join(struct.pack("<I", i) for i in indices), 34963)
-        accessors += [{"bufferView": pv, "componentType": 5126, "count": len(positions), "type": "VEC3", "min": lo, "max": hi},
-                      {"bufferView": nv, "componentType": 5126, "count": len(normals), "type": "VEC3"},
-                      {"bufferView": iv, "componentType": 5125, "count": len(indices), "type": "SCALAR"}]
-        a = len(accessors) - 3
-        primitives.append({"attributes": {"POSITION": a, "NORMAL": a + 1}, "indices": a + 2, "material": m})
-
-    def look_rotation(forward):
-        """The quaternion (x, y, z, w) turning −z to `forward` with +y kept up."""
-        fx, fy, fz = forward
-        yaw = math.atan2(-fx, -fz)
-        pitch = math.asin(fy / math.sqrt(fx * fx + fy * fy + fz * fz))
-        qy = (0.0, math.sin(yaw / 2), 0.0, math.cos(yaw / 2))
-        qx = (math.sin(pitch / 2), 0.0, 0.0, math.cos(pitch / 2))
-        (x1, y1, z1, w1), (x2, y2, z2, w2) = qy, qx
-        return [w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2, w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2,
-                w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2, w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2]
-
     lights = [{"name": "sun", "type": "directional", "color": [1.0, 0.95, 0.85], "intensity": 1.5}]
-    nodes = [{"name": "atrium", "mesh": 0},
-             {"name": "sun", "rotation": look_rotation((0.35, -1.0, 0.2)), "extensions": {"KHR_lights_punctual": {"light": 0}}}]
+    nodes = [{"name": "sun", "rotation": look_rotation((0.35, -1.0, 0.2)), "extensions": {"KHR_lights_punctual": {"light": 0}}}]
     for k, x in enumerate((-12.0, 0.0, 12.0)):
         lights.append({"name": f"gallery {k}", "type": "spot", "color": [1.0, 0.8, 0.6], "intensity": 60.0,
                        "spot": {"innerConeAngle": 0.5, "outerConeAngle": 0.9}})
         nodes.append({"name": f"gallery {k}", "translation": [x, LEVELS[0] - WALL - 0.3, D / 2 - GALLERY / 2],
                       "rotation": look_rotation((0.0, -1.0, 0.0001)), "extensions": {"KHR_lights_punctual": {"light": k + 1}}})
-    nodes.append({"name": "camera", "camera": 0, "translation": [-13.5, 1.7, 6.5],
-                  "rotation": look_rotation((1.0, 0.3, -0.5))})
-    return {
-        "asset": {"version": "2.0", "generator": "kiln scripts/make_atrium.py"},
-        "extensionsUsed": ["KHR_lights_punctual"],
-        "extensions": {"KHR_lights_punctual": {"lights": lights}},
-        "scene": 0,
-        "scenes": [{"nodes": list(range(len(nodes)))}],
-        "nodes": nodes,
-        "cameras": [{"type": "perspective", "perspective": {"yfov": 1.0, "znear": 0.1}}],
-        "meshes": [{"name": "atrium", "primitives": primitives}],
-        "materials": materials,
-        "accessors": accessors,
-        "bufferViews": views,
-        "buffers": [{"byteLength": len(blob), "uri": "data:application/octet-stream;base64," + base64.b64encode(bytes(blob)).decode()}],
-    }
+    camera = {"name": "camera", "camera": 0, "translation": [-13.5, 1.7, 6.5], "rotation": look_rotation((1.0, 0.3, -0.5))}
+    return scene("atrium", "kiln scripts/make_atrium.py", MATERIALS, parts, lights, nodes, camera)
 
 
 if __name__ == "__main__":
