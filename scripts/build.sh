@@ -4,7 +4,8 @@ set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 generator=()
 command -v ninja >/dev/null && generator=(-G Ninja)
-if [ ! -f "$root/build/CMakeCache.txt" ]; then
+# Configured once; again when an earlier configure failed before writing its build files.
+if [ ! -f "$root/build/CMakeCache.txt" ] || { [ ! -f "$root/build/build.ninja" ] && [ ! -f "$root/build/Makefile" ]; }; then
   cmake -S "$root" -B "$root/build" "${generator[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo
 fi
 cmake --build "$root/build" --parallel "$(nproc)" "$@"
