@@ -10,6 +10,7 @@
 
 #include "kiln/data_root.hpp"
 #include "kiln/log.hpp"
+#include "ray/volume_faces.hpp"
 #include "scene/punctual.hpp"
 #include "scene/redraw_region.hpp"
 
@@ -118,6 +119,17 @@ std::optional<uint64_t> App::seedOverride() const {
     return options_.seed == kSceneSeed ? std::nullopt : std::optional<uint64_t>(options_.seed);
 }
 
+uint32_t App::meshClosedFaces(const glm::vec4& volume) {
+    const uint64_t meshes = renderer_.version(kSceneMeshes);
+    if (meshes != closedFacesMeshes_ || volume != closedFacesVolume_) {
+        closedFacesMeshes_ = meshes, closedFacesVolume_ = volume;
+        // Within one voxel of the coarsest volume voxelize offers (32³) of the face.
+        closedFaces_ = ray::closedVolumeFaces(renderer_.rayMeshData(), volume, scene_.boundsMin(), scene_.boundsMax(),
+                                              2.0f * volume.w / 32.0f);
+    }
+    return closedFaces_;
+}
+
 SceneView App::buildView() {
     {
         // The whole scene in view from where the camera is, with room to back off; the
@@ -149,9 +161,13 @@ SceneView App::buildView() {
                                      (look.tumblerB - look.tumblerT) / std::sin(look.tumblerAlpha));
     v.frame.voxelVolume = voxelVolumeAround(scene_.boundsMin(), scene_.boundsMax());
     // The box's walls close the volume's faces only where the volume is the box (a model
-    // reaching out of it widens the volume past the walls).
+    // reaching out of it widens the volume past the walls). Without the box, the faces
+    // its meshes close: a room's walls in the outermost voxels.
     const bool volumeIsBox = v.frame.voxelVolume == glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
-    v.frame.closedFaces = glm::uvec4(look.walls && volumeIsBox ? closedFaceBits(look.closed) : 0u, 0u, 0u, 0u);
+    uint32_t closed = 0;
+    if (look.walls) closed = volumeIsBox ? closedFaceBits(look.closed) : 0u;
+    else closed = meshClosedFaces(v.frame.voxelVolume);
+    v.frame.closedFaces = glm::uvec4(closed, 0u, 0u, 0u);
     v.frame.sceneMin = glm::vec4(scene_.boundsMin(), 0.0f);
     v.frame.sceneMax = glm::vec4(scene_.boundsMax(), 0.0f);
     scene::packPunctualLights(scene_.lights(), scene_.boundsMin(), scene_.boundsMax(), v.frame);

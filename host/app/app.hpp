@@ -76,6 +76,9 @@ public:
 
 private:
     SceneView buildView();
+    // GpuFrame::closedFaces for a scene without the box: the faces of `volume` its meshes
+    // close (ray::closedVolumeFaces), found again when the meshes or the volume change.
+    uint32_t meshClosedFaces(const glm::vec4& volume);
     std::vector<std::string> requestedTextures() const;  // viewed, then alsoRead
     void chooseRedraw(const SceneView&, FrameInfo&);
 
@@ -90,6 +93,9 @@ private:
     uint64_t frameIndex_ = 0;
     glm::mat4 lastViewProj_{0.0f};
     glm::vec4 lastVoxelVolume_{0.0f, 0.0f, 0.0f, 1.0f};
+    uint64_t closedFacesMeshes_ = ~uint64_t(0);
+    glm::vec4 closedFacesVolume_{0.0f};
+    uint32_t closedFaces_ = 0;
     uint64_t cameraVersion_ = 0, timeVersion_ = 0;
     uint64_t lastVersions_[kSceneCategoryCount] = {};  // the last frame's, for chooseRedraw
     int redrawBand_ = 0;

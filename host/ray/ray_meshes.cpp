@@ -59,7 +59,7 @@ void walk(const std::vector<BvhNode>& nodes, uint32_t root, glm::vec3 o, glm::ve
 
 }  // namespace
 
-RayHit RayMeshData::nearestHit(glm::vec3 o, glm::vec3 d, float tMax) const {
+RayHit RayMeshData::nearestHit(glm::vec3 o, glm::vec3 d, float tMax, bool oneSided) const {
     RayHit hit;
     hit.t = tMax;
     if (instances_.empty()) return hit;
@@ -77,7 +77,7 @@ RayHit RayMeshData::nearestHit(glm::vec3 o, glm::vec3 d, float tMax) const {
                     const RayTriangle& tri = triangles_[t];
                     const glm::vec3 p = glm::cross(ld, tri.e2);
                     const float det = glm::dot(tri.e1, p);
-                    if (std::abs(det) < 1e-20f || (ri.twoSided == 0 && det < 0.0f)) continue;
+                    if (std::abs(det) < 1e-20f || (oneSided && ri.twoSided == 0 && det < 0.0f)) continue;
                     const float inv = 1.0f / det;
                     const glm::vec3 s = lo - tri.v0;
                     const float u = glm::dot(s, p) * inv;

@@ -93,9 +93,10 @@ public:
     size_t meshCount() const { return meshRoots_.size(); }
     // The nearest triangle along o + t·d for t in (0, tMax), found as ray_meshes.glsl
     // finds it (the same walk and triangle test; a one-sided instance's back faces are
-    // not hit). Alpha cut-outs are not honoured: the CPU holds no textures. For picking
-    // what a pixel shows, and for checking the GPU's hits.
-    RayHit nearestHit(glm::vec3 origin, glm::vec3 direction, float tMax = INFINITY) const;
+    // not hit; with `oneSided` false every triangle is hit from either side). Alpha
+    // cut-outs are not honoured: the CPU holds no textures. For picking what a pixel
+    // shows, testing where surfaces are, and checking the GPU's hits.
+    RayHit nearestHit(glm::vec3 origin, glm::vec3 direction, float tMax = INFINITY, bool oneSided = true) const;
 
 private:
     std::vector<BvhNode> nodes_;  // every mesh's hierarchy, then the top level's
