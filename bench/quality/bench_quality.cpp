@@ -58,6 +58,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <sstream>
 
 #include "app/app.hpp"
@@ -362,7 +363,6 @@ bool loadReference(app::App& app, const Args& args, Reference& ref) {
 struct Parts {
     std::vector<std::string> names;
     std::vector<metrics::Mask> masks;
-    size_t sceneRegions = 0;  // names[1 .. 1 + sceneRegions) are the scene's
     metrics::Mask domeRing;   // the ceiling within 0.5 m of the lamp's axis (box scenes)
 };
 
@@ -445,7 +445,6 @@ Parts partsOf(app::App& app, const Args& args, const FloatImage& depth, const me
         parts.names.push_back(names[k]);
         parts.masks.push_back(std::move(m));
     }
-    parts.sceneRegions = names.size();
     for (const std::string& text : args.regions) {
         WorldRegion box;
         std::string error;
@@ -473,7 +472,6 @@ struct Result {
     metrics::Errors errors;  // against R
     double indirectRelMse = 0;
     std::vector<std::string> partNames;  // Parts::names
-    size_t sceneRegions = 0;
     std::vector<double> partRelMse;      // per part, against R
     // Less the reference's own noise: estimates of the error against the truth.
     double relMseCorrected = 0, indirectRelMseCorrected = 0;
@@ -546,9 +544,11 @@ bool writeImages(const Args& args, const std::string& label, const FloatImage& i
     return true;
 }
 
-bool score(app::App& app, const Args& args, const std::string& label, const Reference& ref, Result& r);
+bool score(app::App& app, const Args& args, const std::string& label, const Reference& ref, std::optional<Parts>& parts,
+           Result& r);
 
-bool measure(app::App& app, const Args& args, const Setting& setting, const Reference& ref, Result& r) {
+bool measure(app::App& app, const Args& args, const Setting& setting, const Reference& ref, std::optional<Parts>& parts,
+             Result& r) {
     std::string text, error;
     const std::string& pipeline = setting.pipeline.empty() ? args.pipeline : setting.pipeline;
     if (!applyOverrides(slurp(pipeline), setting.overrides, text, error) ||
@@ -564,12 +564,15 @@ bool measure(app::App& app, const Args& args, const Setting& setting, const Refe
     app.runtime().resetTimings();
     for (int f = 0; f < args.frames; ++f) app.frame();
     glFinish();
-    return score(app, args, setting.label, ref, r);
+    return score(app, args, setting.label, ref, parts, r);
 }
 
 // The errors of the frame the pipeline just rendered, and the GPU times of the frames
 // since the last resetTimings.
-bool score(app::App& app, const Args& args, const std::string& label, const Reference& ref, Result& r) {
+// `parts`: found at the first setting scored and kept (every setting shows one scene from
+// one camera, with the same emitters masked).
+bool score(app::App& app, const Args& args, const std::string& label, const Reference& ref, std::optional<Parts>& parts,
+           Result& r) {
     std::string error;
     app.runtime().collectGpuTimes();
     for (auto& errorText : app.runtime().activeErrors()) return fail(label + ": " + errorText);
@@ -590,14 +593,14 @@ bool score(app::App& app, const Args& args, const std::string& label, const Refe
     r.errors = metrics::compare(image, ref.mean, mask);
     r.relMseCorrected = metrics::noiseCorrectedRelativeMse(image, halfA, halfB, mask);
 
-    const TextureRef* depth = app.runtime().findTexture("gbuffer", "depth");
-    if (!depth) return fail(label + ": the pipeline has no gbuffer.depth");
-    const Parts parts =
-        partsOf(app, args, readTexture(depth->id, depth->target, depth->format, depth->width, depth->height), mask);
-    domeRingFigures(image, ref, parts.domeRing, r);
-    const std::vector<metrics::Mask>& partMask = parts.masks;
-    r.partNames = parts.names;
-    r.sceneRegions = parts.sceneRegions;
+    if (!parts) {
+        const TextureRef* depth = app.runtime().findTexture("gbuffer", "depth");
+        if (!depth) return fail(label + ": the pipeline has no gbuffer.depth");
+        parts = partsOf(app, args, readTexture(depth->id, depth->target, depth->format, depth->width, depth->height), mask);
+    }
+    domeRingFigures(image, ref, parts->domeRing, r);
+    const std::vector<metrics::Mask>& partMask = parts->masks;
+    r.partNames = parts->names;
     r.meanRatio.resize(partMask.size());
     for (size_t p = 0; p < partMask.size(); ++p) {
         r.partRelMse.push_back(metrics::relativeMse(image, ref.mean, partMask[p]));
@@ -625,7 +628,7 @@ bool score(app::App& app, const Args& args, const std::string& label, const Refe
 // behind motion; this row can. GPU times: the last --frames frames before --time.
 // False (said on stderr) when it fails or the simulation does not reach the state
 // the reference was rendered from.
-bool measureMoving(app::App& app, const Args& args, const Reference& ref, Result& r) {
+bool measureMoving(app::App& app, const Args& args, const Reference& ref, std::optional<Parts>& parts, Result& r) {
     const uint64_t frozenState = app.scene().sim().stateHash();
     std::string text = slurp(args.pipeline), error;
     if (!app.runtime().loadPipelineText(text, args.pipeline, error)) return fail(args.pipeline + ": " + error);
@@ -650,7 +653,7 @@ bool measureMoving(app::App& app, const Args& args, const Reference& ref, Result
         return fail("the moving run reached t = " + std::to_string(app.scene().time()) +
                     " in another state than the frozen frame's (is the simulation deterministic?)");
     const std::string label = fs::path(args.pipeline).stem().string() + " (moving)";
-    return score(app, args, label, ref, r);
+    return score(app, args, label, ref, parts, r);
 }
 
 void markPareto(std::vector<Result>& results) {
@@ -683,7 +686,7 @@ std::string csvNumber(double v) {
 // errors from the first round (they are deterministic), times the medians of the rounds;
 // the Pareto front marked. False (said on stderr) when a setting fails.
 bool measureAll(app::App& app, const Args& args, const std::vector<Setting>& settings, const Reference& ref,
-                std::vector<Result>& results) {
+                std::optional<Parts>& parts, std::vector<Result>& results) {
     results.assign(settings.size(), Result{});
     std::vector<std::map<std::string, std::vector<double>>> passSamples(settings.size());
     std::vector<std::vector<double>> totals(settings.size());
@@ -691,7 +694,7 @@ bool measureAll(app::App& app, const Args& args, const std::vector<Setting>& set
     for (int round = 0; round < args.repeats; ++round)
         for (size_t i = 0; i < settings.size(); ++i) {
             Result r;
-            if (!measure(app, args, settings[i], ref, r)) return false;
+            if (!measure(app, args, settings[i], ref, parts, r)) return false;
             progress.advance(round * int(settings.size()) + int(i) + 1);
             totals[i].push_back(r.totalMs);
             for (auto& [id, ms] : r.passMs) passSamples[i][id].push_back(ms);
@@ -881,10 +884,11 @@ int main(int argc, char** argv) {
     if (!loadReference(app, args, ref)) return 1;
     if (args.images && (!writeImages(args, "reference", ref.mean, ref.meanIndirect))) return 1;
     std::vector<Result> results;
-    if (!measureAll(app, args, settings, ref, results)) return 1;
+    std::optional<Parts> parts;
+    if (!measureAll(app, args, settings, ref, parts, results)) return 1;
     if (args.time > 0) {  // at t = 0 nothing has moved yet
         Result moving;
-        if (!measureMoving(app, args, ref, moving)) return 1;
+        if (!measureMoving(app, args, ref, parts, moving)) return 1;
         results.push_back(std::move(moving));
     }
     const ReferenceFigures figures = referenceFigures(ref, args, results.front().counted);
