@@ -119,13 +119,16 @@ std::optional<uint64_t> App::seedOverride() const {
     return options_.seed == kSceneSeed ? std::nullopt : std::optional<uint64_t>(options_.seed);
 }
 
-uint32_t App::meshClosedFaces(const glm::vec4& volume) {
+uint32_t App::meshClosedFaces(const glm::vec4& volume, glm::vec3 extent) {
     const uint64_t meshes = renderer_.version(kSceneMeshes);
-    if (meshes != closedFacesMeshes_ || volume != closedFacesVolume_) {
-        closedFacesMeshes_ = meshes, closedFacesVolume_ = volume;
-        // Within one voxel of the coarsest volume voxelize offers (32³) of the face.
-        closedFaces_ = ray::closedVolumeFaces(renderer_.rayMeshData(), volume, scene_.boundsMin(), scene_.boundsMax(),
-                                              2.0f * volume.w / 32.0f);
+    if (meshes != closedFacesMeshes_ || volume != closedFacesVolume_ || extent != closedFacesExtent_) {
+        closedFacesMeshes_ = meshes, closedFacesVolume_ = volume, closedFacesExtent_ = extent;
+        // Within one cell of the coarsest grid voxelize offers (32 along the longest side)
+        // of the face.
+        const glm::vec3 half = volume.w * extent;
+        const glm::vec3 cells = glm::vec3(glm::ivec3(32) >> voxelGridShift(extent));
+        closedFaces_ = ray::closedVolumeFaces(renderer_.rayMeshData(), glm::vec3(volume), half, scene_.boundsMin(),
+                                              scene_.boundsMax(), 2.0f * half / cells);
     }
     return closedFaces_;
 }
@@ -160,13 +163,22 @@ SceneView App::buildView() {
     v.frame.roundCone = glm::vec4(look.tumblerB, look.tumblerT, look.tumblerAlpha,
                                      (look.tumblerB - look.tumblerT) / std::sin(look.tumblerAlpha));
     v.frame.voxelVolume = voxelVolumeAround(scene_.boundsMin(), scene_.boundsMax());
+    const glm::vec3 extent = voxelExtentAround(scene_.boundsMin(), scene_.boundsMax());
+    v.frame.voxelExtent = glm::vec4(extent, 0.0f);
+    {
+        // The voxel grids follow the volume's shape (they only ever shrink from the cube,
+        // so the limits that admitted the pipeline admit them).
+        const glm::ivec3 shift = voxelGridShift(extent);
+        std::string error;
+        if (!runtime_.setGridShape({{shift.x, shift.y, shift.z}}, error)) log::error(error);
+    }
     // The box's walls close the volume's faces only where the volume is the box (a model
     // reaching out of it widens the volume past the walls). Without the box, the faces
     // its meshes close: a room's walls in the outermost voxels.
-    const bool volumeIsBox = v.frame.voxelVolume == glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
+    const bool volumeIsBox = v.frame.voxelVolume == glm::vec4(0.0f, 0.0f, 0.0f, 1.0f) && extent == glm::vec3(1.0f);
     uint32_t closed = 0;
     if (look.walls) closed = volumeIsBox ? closedFaceBits(look.closed) : 0u;
-    else closed = meshClosedFaces(v.frame.voxelVolume);
+    else closed = meshClosedFaces(v.frame.voxelVolume, extent);
     v.frame.closedFaces = glm::uvec4(closed, 0u, 0u, 0u);
     v.frame.sceneMin = glm::vec4(scene_.boundsMin(), 0.0f);
     v.frame.sceneMax = glm::vec4(scene_.boundsMax(), 0.0f);
@@ -177,6 +189,7 @@ SceneView App::buildView() {
 
     if (v.frame.viewProj != lastViewProj_) lastViewProj_ = v.frame.viewProj, ++cameraVersion_;
     lastVoxelVolume_ = v.frame.voxelVolume;
+    lastVoxelExtent_ = extent;
     for (int i = 0; i < kSceneGeometryCount; ++i) {
         const auto c = SceneCategory(1u << i);
         v.versions[i] = renderer_.version(c);

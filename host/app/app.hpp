@@ -44,6 +44,7 @@ public:
     const glm::mat4& viewProj() const { return lastViewProj_; }
     // The voxel volume of the last frame built (GpuFrame::voxelVolume).
     const glm::vec4& voxelVolume() const { return lastVoxelVolume_; }
+    glm::vec3 voxelExtent() const { return lastVoxelExtent_; }
     // The graph output, or the texture chosen with --view / in the debug view.
     const TextureRef* displayedTexture() const;
 
@@ -78,7 +79,7 @@ private:
     SceneView buildView();
     // GpuFrame::closedFaces for a scene without the box: the faces of `volume` its meshes
     // close (ray::closedVolumeFaces), found again when the meshes or the volume change.
-    uint32_t meshClosedFaces(const glm::vec4& volume);
+    uint32_t meshClosedFaces(const glm::vec4& volume, glm::vec3 extent);
     std::vector<std::string> requestedTextures() const;  // viewed, then alsoRead
     void chooseRedraw(const SceneView&, FrameInfo&);
 
@@ -93,8 +94,10 @@ private:
     uint64_t frameIndex_ = 0;
     glm::mat4 lastViewProj_{0.0f};
     glm::vec4 lastVoxelVolume_{0.0f, 0.0f, 0.0f, 1.0f};
+    glm::vec3 lastVoxelExtent_{1.0f};
     uint64_t closedFacesMeshes_ = ~uint64_t(0);
     glm::vec4 closedFacesVolume_{0.0f};
+    glm::vec3 closedFacesExtent_{0.0f};
     uint32_t closedFaces_ = 0;
     uint64_t cameraVersion_ = 0, timeVersion_ = 0;
     uint64_t lastVersions_[kSceneCategoryCount] = {};  // the last frame's, for chooseRedraw

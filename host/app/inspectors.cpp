@@ -162,7 +162,7 @@ void legendLabels(WindowState& state) {
 void panelTrace(WindowState& state) {
     App& app = *state.app;
     if (!state.showTrace || !state.traceUv) return;
-    state.trace = tracePixel(app.runtime(), glm::inverse(app.viewProj()), app.voxelVolume(), *state.traceUv);
+    state.trace = tracePixel(app.runtime(), glm::inverse(app.viewProj()), app.voxelVolume(), app.voxelExtent(), *state.traceUv);
     const PixelTrace& t = state.trace;
     const float cx = float(state.image.x) + t.uv.x * float(state.image.z), cy = float(state.image.y) + (1.0f - t.uv.y) * float(state.image.w);
     ImDrawList* fg = ImGui::GetForegroundDrawList();

@@ -38,7 +38,8 @@ void findWorld(const std::vector<run::NamedTexture>& textures, const glm::mat4& 
 
 }  // namespace
 
-PixelTrace tracePixel(const run::Runtime& runtime, const glm::mat4& invViewProj, glm::vec4 voxelVolume, glm::vec2 uv) {
+PixelTrace tracePixel(const run::Runtime& runtime, const glm::mat4& invViewProj, glm::vec4 voxelVolume, glm::vec3 voxelExtent,
+                      glm::vec2 uv) {
     PixelTrace trace;
     trace.uv = glm::clamp(uv, glm::vec2(0.0f), glm::vec2(1.0f));
     const std::vector<run::NamedTexture> textures = runtime.textures();
@@ -57,8 +58,8 @@ PixelTrace tracePixel(const run::Runtime& runtime, const glm::mat4& invViewProj,
         for (int tile = 0; tile < tiles; ++tile) {
             row.tile = tiles > 1 ? tile : -1;
             if (trace.world) {
-                const glm::vec3 volume = (*trace.world - glm::vec3(voxelVolume)) / voxelVolume.w;
-                const glm::vec3 p01 = glm::clamp((volume + 1.0f) * 0.5f, glm::vec3(0.0f), glm::vec3(0.999999f));
+                const glm::vec3 grid = (*trace.world - glm::vec3(voxelVolume)) / (voxelVolume.w * voxelExtent);
+                const glm::vec3 p01 = glm::clamp((grid + 1.0f) * 0.5f, glm::vec3(0.0f), glm::vec3(0.999999f));
                 row.texel = glm::ivec3(p01 * glm::vec3(blockWidth, t.ref.height, t.ref.depth));
                 row.texel.x += tile * blockWidth;
                 row.value = readTexel(t.ref, row.texel);

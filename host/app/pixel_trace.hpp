@@ -33,9 +33,10 @@ struct PixelTrace {
     std::vector<TraceRow> rows;
 };
 
-// `invViewProj`: the camera's, for the frame the textures hold; `voxelVolume` that
-// frame's (GpuFrame::voxelVolume), where a 3D texture is read. The camera's depth is
+// `invViewProj`: the camera's, for the frame the textures hold; `voxelVolume` and
+// `voxelExtent` that frame's (GpuFrame's), where a 3D texture is read. The camera's depth is
 // the 2D depth texture declared with the camera's planes (kCameraNear, kCameraFar).
-PixelTrace tracePixel(const run::Runtime&, const glm::mat4& invViewProj, glm::vec4 voxelVolume, glm::vec2 uv);
+PixelTrace tracePixel(const run::Runtime&, const glm::mat4& invViewProj, glm::vec4 voxelVolume, glm::vec3 voxelExtent,
+                      glm::vec2 uv);
 
 }  // namespace kiln::app

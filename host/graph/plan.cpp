@@ -127,7 +127,8 @@ std::vector<int> Plan::runOrder() const {
 
 // ---- sizes -----------------------------------------------------------------------
 
-Extent resolveSize(const TextureDecl& t, int outW, int outH, const ResolvedParams& params, const Extent* input) {
+Extent resolveSize(const TextureDecl& t, int outW, int outH, const ResolvedParams& params, const Extent* input,
+                   const GridShape& grid) {
     const bool is3D = t.kind == TextureKind::Color3D;
     Extent e;
     switch (t.size.mode) {
@@ -148,9 +149,10 @@ Extent resolveSize(const TextureDecl& t, int outW, int outH, const ResolvedParam
         case SizeRule::Mode::FromParam: {
             const int* side = params.get<int>(t.size.source);
             const int s = side ? std::max(1, int(std::lround(*side * double(t.size.scale)))) : 1;
-            e.w = s * std::max(1, t.size.tiles);
-            e.h = s;
-            e.d = is3D ? s : 1;
+            auto along = [&](int axis) { return is3D ? std::max(1, s >> std::clamp(grid.shift[axis], 0, 30)) : s; };
+            e.w = along(0) * std::max(1, t.size.tiles);
+            e.h = along(1);
+            e.d = is3D ? along(2) : 1;
             break;
         }
         case SizeRule::Mode::RelativeOverParam: {
@@ -174,17 +176,17 @@ Extent resolveSize(const TextureDecl& t, int outW, int outH, const ResolvedParam
     return e;
 }
 
-Extent Plan::extentOf(int pass, std::string_view name, int outW, int outH) const {
+Extent Plan::extentOf(int pass, std::string_view name, int outW, int outH, const GridShape& grid) const {
     if (pass < 0 || pass >= static_cast<int>(passes.size())) return {};
     const PlannedPass& p = passes[static_cast<size_t>(pass)];
     const TextureDecl* t = p.texture(name);
     if (!t) return {};
-    if (t->size.mode != SizeRule::Mode::FromInput) return resolveSize(*t, outW, outH, p.params);
+    if (t->size.mode != SizeRule::Mode::FromInput) return resolveSize(*t, outW, outH, p.params, nullptr, grid);
     // Producers come earlier in file order, so this recursion ends.
     const Binding* b = p.binding(t->size.source);
-    if (!b || !b->bound() || b->producer >= pass) return resolveSize(*t, outW, outH, p.params);
-    const Extent in = extentOf(b->producer, b->output, outW, outH);
-    return resolveSize(*t, outW, outH, p.params, &in);
+    if (!b || !b->bound() || b->producer >= pass) return resolveSize(*t, outW, outH, p.params, nullptr, grid);
+    const Extent in = extentOf(b->producer, b->output, outW, outH, grid);
+    return resolveSize(*t, outW, outH, p.params, &in, grid);
 }
 
 std::string describeSize(const TextureDecl& t, const ResolvedParams& params) {

@@ -94,6 +94,14 @@ struct Extent {
     bool operator==(const Extent&) const = default;
 };
 
+// How a 3D FromParam texture (a voxel grid) follows the scene's voxel volume: its side
+// along axis a is the parameter halved shift[a] times (kiln::voxelGridShift), so a
+// room's grid has as many cells across its height as the room is tall. All zero: a cube.
+struct GridShape {
+    int shift[3] = {0, 0, 0};
+    bool operator==(const GridShape&) const = default;
+};
+
 struct Plan {
     std::string fileName;
     std::vector<PlannedPass> passes;     // file order = execution order
@@ -105,7 +113,7 @@ struct Plan {
     std::vector<int> runOrder() const;         // indices of the passes that run
     // The extent of pass `pass`'s output or internal `name` for a graph output of
     // outW×outH, following FromInput sizes through the bindings ({1,1,1} if unknown).
-    Extent extentOf(int pass, std::string_view name, int outW, int outH) const;
+    Extent extentOf(int pass, std::string_view name, int outW, int outH, const GridShape& grid = {}) const;
 
     // Fixed-width text table: #, id, module, state (and why), inputs
     // (slot←pass.output or slot←fallback:black), outputs (name format size-rule).
@@ -118,10 +126,12 @@ struct Plan {
 // The size of an output/internal texture for a graph output of outW×outH:
 // RelativeToOutput: round(scale × out), at least 1 (2D);
 // Fixed: width × height (× depth for 3D);
-// FromParam: a square (2D) or cube (3D) whose side is the int parameter (at least 1);
+// FromParam: a square (2D) whose side is the int parameter (at least 1), or a grid (3D)
+//   that long on its longest side and shortened along each axis by `grid`;
 // FromInput: `input` (the extent of what is bound to the slot) × scale, 1 when null.
 // compile() guarantees FromParam names an int parameter; if it does not, the side is 1.
-Extent resolveSize(const TextureDecl&, int outW, int outH, const ResolvedParams&, const Extent* input = nullptr);
+Extent resolveSize(const TextureDecl&, int outW, int outH, const ResolvedParams&, const Extent* input = nullptr,
+                   const GridShape& grid = {});
 
 // "1x", "0.5x", "256x256", "64x64x64", "size(=2048)" — as the table prints it.
 std::string describeSize(const TextureDecl&, const ResolvedParams&);

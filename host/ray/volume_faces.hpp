@@ -12,13 +12,13 @@
 
 namespace kiln::ray {
 
-// Each face of the cube `volume` (xyz centre, w half its side), tested over the part of it
-// the scene's bounds [lo, hi] cover (beyond them its outermost voxels are empty, and an
-// empty voxel clamped is empty space all the same) by a grid of `grid` × `grid` rays cast
-// from just outside it inward, either side of a triangle counting: closed when at least
-// `share` of them meet a triangle within `depth` of the face. Bit 2a for the face at
+// Each face of the box `centre` ± `half`, tested over the part of it the scene's bounds
+// [lo, hi] cover (beyond them its outermost voxels are empty, and an empty voxel clamped
+// is empty space all the same) by a grid of `grid` × `grid` rays cast from just outside
+// it inward, either side of a triangle counting: closed when at least `share` of them
+// meet a triangle within `depth[a]` of a face across axis a. Bit 2a for the face at
 // −axis a, 2a + 1 for +axis a (GpuFrame::closedFaces.x).
-uint32_t closedVolumeFaces(const RayMeshData& meshes, glm::vec4 volume, glm::vec3 lo, glm::vec3 hi, float depth,
-                           int grid = 16, float share = 0.9f);
+uint32_t closedVolumeFaces(const RayMeshData& meshes, glm::vec3 centre, glm::vec3 half, glm::vec3 lo, glm::vec3 hi,
+                           glm::vec3 depth, int grid = 16, float share = 0.9f);
 
 }  // namespace kiln::ray

@@ -118,7 +118,7 @@ bool Runtime::loadPipelineDesc(graph::PipelineDesc desc, std::string& errors) {
         errors = result.errorText();
         return false;
     }
-    if (std::string tooLarge = checkTextureLimits(*result, options_.width, options_.height, limits_); !tooLarge.empty()) {
+    if (std::string tooLarge = checkTextureLimits(*result, options_.width, options_.height, limits_, grid_); !tooLarge.empty()) {
         errors = tooLarge;
         return false;
     }
@@ -259,7 +259,7 @@ void Runtime::allocateTextures(size_t i) {
     if (planned.state == graph::PassState::Disabled) return;
     bool changed = false;
     auto want = [&](const TextureDecl& d, bool internal) {
-        const graph::Extent e = plan_->extentOf(static_cast<int>(i), d.name, options_.width, options_.height);
+        const graph::Extent e = plan_->extentOf(static_cast<int>(i), d.name, options_.width, options_.height, grid_);
         changed |= ensureTexture(slot.textures, d, e, internal, slot.id + "." + d.name, ++versionCounter_);
     };
     for (auto& d : planned.decl.outputs) want(d, false);
@@ -273,7 +273,7 @@ bool Runtime::resize(int width, int height, std::string& error) {
     width = std::max(1, width), height = std::max(1, height);
     if (width == options_.width && height == options_.height) return true;
     if (plan_) {
-        error = checkTextureLimits(*plan_, width, height, limits_);
+        error = checkTextureLimits(*plan_, width, height, limits_, grid_);
         if (!error.empty()) return false;  // the textures keep their size
     }
     options_.width = width;
@@ -281,6 +281,18 @@ bool Runtime::resize(int width, int height, std::string& error) {
     if (!plan_) return true;
     // In order: a texture sized from an input follows its producer's new size.
     for (size_t i = 0; i < slots_.size(); ++i) allocateTextures(i);
+    return true;
+}
+
+bool Runtime::setGridShape(const graph::GridShape& grid, std::string& error) {
+    if (grid == grid_) return true;
+    if (plan_) {
+        error = checkTextureLimits(*plan_, options_.width, options_.height, limits_, grid);
+        if (!error.empty()) return false;
+    }
+    grid_ = grid;
+    if (plan_)
+        for (size_t i = 0; i < slots_.size(); ++i) allocateTextures(i);
     return true;
 }
 

@@ -70,6 +70,10 @@ public:
     // New output size; refused (textures unchanged, `error` says why) when the plan's
     // textures would not fit the GL limits or the budget at that size.
     bool resize(int width, int height, std::string& error);
+    // The voxel grids' shape (the scene's voxel volume, kiln::voxelGridShift): their
+    // textures take the new sides where it changes. Refused like resize.
+    bool setGridShape(const graph::GridShape& grid, std::string& error);
+    const graph::GridShape& gridShape() const { return grid_; }
 
     void renderFrame(const SceneView& view, const SceneDraw& scene, const FrameInfo& frame);
     // Harvests finished GPU timer queries (renderFrame does it each frame; call after
@@ -154,6 +158,7 @@ private:
     bool applyOverrides(graph::PipelineDesc&, std::string& errors);
 
     RuntimeOptions options_;
+    graph::GridShape grid_;
     std::unique_ptr<ModuleRegistry> modules_;
     std::unique_ptr<ShaderLibrary> shaders_;
     std::optional<graph::Plan> plan_;

@@ -59,14 +59,15 @@ std::string mib(uint64_t bytes) { return std::to_string((bytes + (1u << 20) - 1)
 
 }  // namespace
 
-std::string checkTextureLimits(const graph::Plan& plan, int outW, int outH, const TextureLimits& limits) {
+std::string checkTextureLimits(const graph::Plan& plan, int outW, int outH, const TextureLimits& limits,
+                               const graph::GridShape& grid) {
     std::string problems;
     uint64_t total = 0;
     for (size_t i = 0; i < plan.passes.size(); ++i) {
         const graph::PlannedPass& p = plan.passes[i];
         if (p.state == graph::PassState::Disabled) continue;
         auto check = [&](const TextureDecl& d) {
-            const graph::Extent e = plan.extentOf(int(i), d.name, outW, outH);
+            const graph::Extent e = plan.extentOf(int(i), d.name, outW, outH, grid);
             const bool is3D = d.kind == TextureKind::Color3D;
             const int limit = is3D ? limits.max3D : limits.max2D;
             const std::string size = std::to_string(e.w) + "x" + std::to_string(e.h) + (is3D ? "x" + std::to_string(e.d) : "");

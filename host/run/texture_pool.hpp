@@ -31,9 +31,10 @@ struct TextureLimits {
 };
 
 // Checks every texture of every pass that is not disabled at an output size of
-// outW×outH; "" when all fit, else one line per problem naming the pass, the texture,
-// its size and the limit.
-std::string checkTextureLimits(const graph::Plan&, int outW, int outH, const TextureLimits&);
+// outW×outH (voxel grids shaped by `grid`); "" when all fit, else one line per problem
+// naming the pass, the texture, its size and the limit.
+std::string checkTextureLimits(const graph::Plan&, int outW, int outH, const TextureLimits&,
+                               const graph::GridShape& grid = {});
 
 struct PooledTexture {
     TextureDecl decl;

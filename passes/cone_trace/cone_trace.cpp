@@ -225,7 +225,8 @@ public:
             return ctx.fail("`lamp` on and `lamp_transmittance` bound: both would fill the output's alpha; "
                             "composite's lamp_model traced reads the one, lamp_through_fire the other");
         const kiln::TextureRef& voxels = ctx.input("voxels");
-        kiln::Defines defines = schedule(ctx, voxels.width);
+        const int longest = std::max({voxels.width, voxels.height, voxels.depth});  // the schedule's voxel
+        kiln::Defines defines = schedule(ctx, longest);
         defines.emplace_back("KILN_LAMP_IN_ALPHA", ctx.getBool("lamp") ? "1" : "0");
         // 16 silhouette vertices: within 1 % (tests/gi/test_lamp.cpp).
         defines.emplace_back("KILN_LAMP_SAMPLES", "16");
@@ -264,7 +265,8 @@ public:
         }
         glUniform1f(loc("u_startOffset"), ctx.getFloat("start_offset"));
         glUniform1f(loc("u_diameterOffset"), ctx.getFloat("diameter_offset"));
-        glUniform1f(loc("u_voxelRes"), float(voxels.width));
+        glUniform1f(loc("u_voxelRes"), float(longest));
+        glUniform3f(loc("u_voxelDims"), float(voxels.width), float(voxels.height), float(voxels.depth));
         glUniform1i(loc("u_stride"), traceStep);
         const kiln::TextureRef& target = upsampled ? ctx.internal("samples") : ctx.output("indirect");
         kiln::gl::bindImage(trace, "u_traced", target.id, 0, false, GL_WRITE_ONLY, GL_RGBA16F);

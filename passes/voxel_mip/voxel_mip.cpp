@@ -187,7 +187,9 @@ public:
                             "reflects, and which way");
         if (ctx.getEnum("facing") != "off" && !ctx.isBound("normal"))
             return ctx.fail("facing needs `normal` bound (voxelize.normal): which way each voxel's surface faces");
-        const int res = chain.width;  // = the input's (SizeRule::fromInput)
+        // The grid (= the input's, SizeRule::fromInput) and its longest side, the cones' unit.
+        const glm::ivec3 grid(chain.width, chain.height, chain.depth);
+        const int res = std::max({grid.x, grid.y, grid.z});
         auto gatherProgram = [&](BounceStep step) {
             return ctx.program({.stages = {"voxel_mip/bounce.comp"}, .defines = gatherDefines(ctx, res, step)});
         };
@@ -203,16 +205,17 @@ public:
         // made or feedback turned on).
         const kiln::TextureRef& kept = ctx.internal("feedback");
         if (feedback) {
-            if (keptId_ != kept.id || keptRes_ != kept.width) {  // a name can be reused for a new texture
+            const glm::ivec3 keptGrid(kept.width, kept.height, kept.depth);
+            if (keptId_ != kept.id || keptGrid_ != keptGrid) {  // a name can be reused for a new texture
                 clearAllLevels(kept);
                 keptId_ = kept.id;
-                keptRes_ = kept.width;
+                keptGrid_ = keptGrid;
             }
             if (listed) startGatherList(ctx);  // the reflection lists the blocks to gather at
             dispatchGather(ctx, reflectKept, chain.id, 0);
         } else {
             keptId_ = 0;  // turned back on later: starts from nothing
-            glCopyImageSubData(in.id, GL_TEXTURE_3D, 0, 0, 0, 0, chain.id, GL_TEXTURE_3D, 0, 0, 0, 0, res, res, res);
+            glCopyImageSubData(in.id, GL_TEXTURE_3D, 0, 0, 0, 0, chain.id, GL_TEXTURE_3D, 0, 0, 0, 0, grid.x, grid.y, grid.z);
         }
         buildChains(ctx, iso, aniso);
 
@@ -221,7 +224,8 @@ public:
         for (int b = 2; b <= bounces; ++b) {
             const kiln::TextureRef& bounced = ctx.internal("bounced");
             dispatchGather(ctx, bounce, bounced.id, chain.id);
-            glCopyImageSubData(bounced.id, GL_TEXTURE_3D, 0, 0, 0, 0, chain.id, GL_TEXTURE_3D, 0, 0, 0, 0, res, res, res);
+            glCopyImageSubData(bounced.id, GL_TEXTURE_3D, 0, 0, 0, 0, chain.id, GL_TEXTURE_3D, 0, 0, 0, 0, grid.x, grid.y,
+                               grid.z);
             buildChains(ctx, iso, aniso);
         }
         if (feedback) {
@@ -232,12 +236,13 @@ public:
 
 private:
     static GLuint groups(int n) { return GLuint((n + 3) / 4); }
+    static glm::ivec3 gridOf(const kiln::TextureRef& t) { return {t.width, t.height, t.depth}; }
 
     // gatherList_ emptied, for the reflection of the kept gather (bounce.comp step 2) to
     // list the blocks that hold a surface for the gather's indirect dispatch (step 1).
     void startGatherList(kiln::PassContext& ctx) {
-        const int blocks = ctx.output("iso").width / ctx.getInt("gather_block");
-        const GLsizeiptr bytes = 16 + 4 * GLsizeiptr(blocks) * blocks * blocks;
+        const glm::ivec3 blocks = gridOf(ctx.output("iso")) / ctx.getInt("gather_block");
+        const GLsizeiptr bytes = 16 + 4 * GLsizeiptr(blocks.x) * blocks.y * blocks.z;
         if (!gatherList_ || gatherList_.size() < bytes)
             gatherList_ = kiln::gl::Buffer::create(bytes, nullptr, GL_DYNAMIC_STORAGE_BIT, "voxel_mip.gather_list");
         const GLuint empty[4] = {0, 1, 1, 0};  // no groups yet, 1 × 1; nothing listed
@@ -248,9 +253,10 @@ private:
     // `chainsRead` (iso) and the other chains are what its cones trace, if it gathers.
     // `listed`: over the blocks step 2 listed, an indirect dispatch.
     void dispatchGather(kiln::PassContext& ctx, GLuint program, GLuint target, GLuint chainsRead, bool listed = false) {
-        const int res = ctx.output("iso").width;
+        const glm::ivec3 grid = gridOf(ctx.output("iso"));
         glUseProgram(program);
-        glUniform1f(glGetUniformLocation(program, "u_voxelRes"), float(res));
+        glUniform1f(glGetUniformLocation(program, "u_voxelRes"), float(std::max({grid.x, grid.y, grid.z})));
+        glUniform3f(glGetUniformLocation(program, "u_voxelDims"), float(grid.x), float(grid.y), float(grid.z));
         glUniform1f(glGetUniformLocation(program, "u_startOffset"), ctx.getFloat("gather_start_offset"));
         glUniform1f(glGetUniformLocation(program, "u_diameterOffset"), ctx.getFloat("gather_diameter_offset"));
         kiln::gl::bindTexture(program, "u_emitted", ctx.input("radiance").id);
@@ -270,8 +276,8 @@ private:
             glDispatchComputeIndirect(0);
             glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, 0);
         } else {
-            const int blocks = res / ctx.getInt("gather_block");
-            glDispatchCompute(groups(blocks), groups(blocks), groups(blocks));
+            const glm::ivec3 blocks = grid / ctx.getInt("gather_block");
+            glDispatchCompute(groups(blocks.x), groups(blocks.y), groups(blocks.z));
         }
         glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
                         GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
@@ -286,23 +292,26 @@ private:
         const kiln::TextureRef& atlas = ctx.output("aniso");
         const kiln::TextureRef& fixed = ctx.output("fixed_cones");
         const std::string& mode = ctx.getEnum("mode");
-        const int res = chain.width;
+        const glm::ivec3 grid = gridOf(chain);
         const bool facing = ctx.getEnum("facing") != "off";
         glUseProgram(iso);
         for (int level = 1; level < chain.levels; ++level) {
-            const int n = std::max(1, res >> level);
+            const glm::ivec3 n = glm::max(grid >> level, glm::ivec3(1));
             glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
             kiln::gl::bindImage(iso, "u_src", chain.id, level - 1, true, GL_READ_ONLY, GL_RGBA16F);
             kiln::gl::bindImage(iso, "u_dst", chain.id, level, true, GL_WRITE_ONLY, GL_RGBA16F);
-            glDispatchCompute(groups(n), groups(n), groups(n));
+            glDispatchCompute(groups(n.x), groups(n.y), groups(n.z));
         }
 
         const bool blended = mode == "fixed_cones";
         if (mode != "iso") {
-            // Directional level L (1 … log2 res) lives in atlas level L−1, octant side res>>L;
-            // with fixed_cones, blended into the fixed chains' level L−1 as it is built.
-            for (int L = 1; (res >> L) >= 1; ++L) {
-                const int n = res >> L;
+            // Directional level L (1 … log2 of the shortest side) lives in atlas level L−1,
+            // octant sides grid>>L; with fixed_cones, blended into the fixed chains' level
+            // L−1 as it is built. Past the shortest side's last level an octant would be
+            // under one voxel across: the cones read the top level there (voxels.glsl).
+            const int shortest = std::min({grid.x, grid.y, grid.z});
+            for (int L = 1; (shortest >> L) >= 1; ++L) {
+                const glm::ivec3 n = grid >> L;
                 const GLuint aniso = L == 1 ? anisoPrograms.fromBase : anisoPrograms.fromLevel;
                 glUseProgram(aniso);
                 glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
@@ -313,8 +322,8 @@ private:
                 kiln::gl::bindImage(aniso, "u_dst", atlas.id, L - 1, true, GL_WRITE_ONLY, GL_RGBA16F);
                 if (blended) kiln::gl::bindImage(aniso, "u_fixed", fixed.id, L - 1, true, GL_WRITE_ONLY, GL_RGBA16F);
                 if (facing && L == 1) kiln::gl::bindTexture(aniso, "u_normal", ctx.input("normal").id);
-                glUniform1i(glGetUniformLocation(aniso, "u_size"), n);
-                glDispatchCompute(groups(n), groups(n), groups(n));
+                glUniform3i(glGetUniformLocation(aniso, "u_size"), n.x, n.y, n.z);
+                glDispatchCompute(groups(n.x), groups(n.y), groups(n.z));
             }
             atlasCleared_ = false;
         } else if (!atlasCleared_) {
@@ -335,7 +344,7 @@ private:
     }
 
     GLuint keptId_ = 0;          // the feedback texture cleared last: another (or 0) means start over
-    int keptRes_ = 0;
+    glm::ivec3 keptGrid_{0};
     bool atlasCleared_ = false;  // cache flags only
     bool fixedCleared_ = false;
     kiln::gl::Buffer gatherList_;  // feedback with gather_list: the dispatch size, the count, the blocks

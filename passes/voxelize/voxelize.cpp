@@ -1,4 +1,6 @@
-// voxelize — the scene's outgoing radiance in a res³ volume over the scene (GpuFrame::voxelVolume):
+// voxelize — the scene's outgoing radiance in a voxel grid over the scene's bounds
+// (GpuFrame::voxelVolume; `resolution` cells along the longest side, the others in
+// proportion, kiln::voxelGridShift):
 // direct light from the lamp (hard shadow from `shadow_map`, no PCF; the
 // same lampLight() as composite) plus emission, from the Cornell box, the lamp dome,
 // the tumblers (low-poly LOD), the fireballs and the particles (marbles on request).
@@ -121,7 +123,7 @@ public:
                            "lamp or the box changes: each frame's sums start from them"});
         d.internal({.name = "lamp_field", .format = Format::RG16F, .size = SizeRule::fixed(kLampFieldSide, kLampFieldSide),
                     .doc = "lamp_model field: the lamp's vector irradiance over (distance from its axis, height)"});
-        d.param(intChoiceParam("resolution", 64, {32, 64, 128}, "voxels per side of the voxel volume (the cube around the scene)"))
+        d.param(intChoiceParam("resolution", 64, {32, 64, 128}, "voxels along the longest side of the scene's bounds (the other sides in proportion, as powers of two)"))
             .param(boolParam("conservative", true, "enlarge triangles by half a voxel (no holes from thin triangles)"))
             .param(boolParam("keep_static", true,
                              "rasterize the walls and the lamp dome once (again when they or the lamp change) "
@@ -214,7 +216,7 @@ public:
             return;
         if (field && !buildLampField(ctx)) return;
         const kiln::TextureRef& out = ctx.output("radiance");
-        const int res = out.width;
+        const glm::ivec3 res(out.width, out.height, out.depth);  // the grid: per axis (kiln::voxelGridShift)
 
         // The sums start from the static ones (integer sums: the order of adding is free),
         // then the walls' lamp light.
@@ -244,20 +246,21 @@ private:
     // the shadow map's eye) and the walls without their lamp light into `static_sums`,
     // the walls' fragments recorded for lightStatic(); when what they depend on changed.
     // False when the pass failed.
-    bool voxelizeStatic(kiln::PassContext& ctx, GLuint raster, GLuint recorder, int res,
+    bool voxelizeStatic(kiln::PassContext& ctx, GLuint raster, GLuint recorder, glm::ivec3 res,
                         const kiln::TextureRef& staticSums) {
         const kiln::SceneView& scene = ctx.scene();
         // The debug view edits a parameter on the same object: the two the voxels depend
         // on are in the key (lamp_model and fire_cover change the programs).
         const StaticKey key{scene.version(kiln::kSceneLightSurface), scene.version(kiln::kSceneLights),
                             scene.version(kiln::kScenePlanes), scene.version(kiln::kSceneMeshes), scene.frame.ringsLight, scene.frame.ringsDark,
-                            staticSums.id, raster, recorder, res, ctx.getFloat("lamp_emission"),
-                            ctx.getBool("conservative")};
+                            scene.frame.voxelVolume, scene.frame.voxelExtent, staticSums.id, raster, recorder, res,
+                            ctx.getFloat("lamp_emission"), ctx.getBool("conservative")};
         if (key == builtStatic_) return true;
         // Room for every wall fragment: a wall covers at most (res + 2)² pixels of its
         // axis (the conservative half voxel), its triangles' shared edges a few more. A
         // shortfall is counted (u_recorded goes on): then it grows and records again.
-        GLsizeiptr needed = std::max<GLsizeiptr>(GLsizeiptr(8) * (res + 2) * (res + 2), staticCapacity_);
+        const int side = std::max({res.x, res.y, res.z});
+        GLsizeiptr needed = std::max<GLsizeiptr>(GLsizeiptr(8) * (side + 2) * (side + 2), staticCapacity_);
         for (int attempt = 0; attempt < 2; ++attempt) {
             if (!staticFragments_ || needed > staticCapacity_) {
                 staticCapacity_ = needed;
@@ -291,7 +294,7 @@ private:
 
     // keep_static: the walls' recorded fragments lit by this frame's lamp and shadow map,
     // added to the sums (voxelize/static_light.comp).
-    void lightStatic(kiln::PassContext& ctx, GLuint program, int res) {
+    void lightStatic(kiln::PassContext& ctx, GLuint program, glm::ivec3 res) {
         if (staticRecorded_ == 0) return;
         glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
         useSurfaceProgram(ctx, program, res);
@@ -301,19 +304,22 @@ private:
 
     // The raster state for adding meshes to sums `target`: the program in use with its
     // inputs bound, an attachment-less framebuffer of the voxels' size.
-    void beginRaster(kiln::PassContext& ctx, GLuint raster, int res, GLuint target) {
+    void beginRaster(kiln::PassContext& ctx, GLuint raster, glm::ivec3 res, GLuint target) {
         // One viewport an axis (voxelize.geom), whole llvmpipe tiles apart, so that its
         // threads share the fragments (on one 32² viewport one thread shaded them all).
-        const int axisStep = (res + kRasterTile - 1) / kRasterTile * kRasterTile;
+        // Along x the grid's y × z columns, along y its z × x, along z its x × y.
+        const int side = std::max({res.x, res.y, res.z});
+        const int axisStep = (side + kRasterTile - 1) / kRasterTile * kRasterTile;
         if (!fbo_) fbo_ = kiln::gl::createFramebuffer();
-        if (fboSize_ != res) {
+        if (fboSize_ != side) {
             glNamedFramebufferParameteri(fbo_.id(), GL_FRAMEBUFFER_DEFAULT_WIDTH, 3 * axisStep);
-            glNamedFramebufferParameteri(fbo_.id(), GL_FRAMEBUFFER_DEFAULT_HEIGHT, res);
-            fboSize_ = res;
+            glNamedFramebufferParameteri(fbo_.id(), GL_FRAMEBUFFER_DEFAULT_HEIGHT, side);
+            fboSize_ = side;
         }
         glBindFramebuffer(GL_FRAMEBUFFER, fbo_.id());
+        const glm::ivec2 viewport[3] = {{res.y, res.z}, {res.z, res.x}, {res.x, res.y}};
         for (GLuint axis = 0; axis < 3; ++axis)
-            glViewportIndexedf(axis, float(axis) * axisStep, 0.0f, float(res), float(res));
+            glViewportIndexedf(axis, float(axis) * axisStep, 0.0f, float(viewport[axis].x), float(viewport[axis].y));
         glDisable(GL_DEPTH_TEST);
         glDisable(GL_CULL_FACE);
         glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
@@ -333,7 +339,7 @@ private:
 
     // 1–3: the box and the lamp (unless kept), the tumblers and whatever is not splatted,
     // rasterised into the sums (no attachments: the fragment shader only does atomics).
-    void rasterize(kiln::PassContext& ctx, GLuint raster, int res, bool rasterStatic, bool rasterParticles,
+    void rasterize(kiln::PassContext& ctx, GLuint raster, glm::ivec3 res, bool rasterStatic, bool rasterParticles,
                    bool rasterFireballs, bool rasterTumblers) {
         beginRaster(ctx, raster, res, ctx.internal("sums").id);
         if (rasterStatic) drawDome(ctx, raster);
@@ -355,13 +361,14 @@ private:
 
     // A program that lights surfaces (voxelize/surface.glsl) and adds them to the sums:
     // in use, with its shadow map, lamp field, sums and their uniforms bound.
-    static void useSurfaceProgram(kiln::PassContext& ctx, GLuint program, int res) {
+    static void useSurfaceProgram(kiln::PassContext& ctx, GLuint program, glm::ivec3 res) {
         glUseProgram(program);
         kiln::gl::bindTexture(program, "u_shadowMap", ctx.input("shadow_map").id);
         kiln::gl::bindTexture(program, "u_lampField", ctx.internal("lamp_field").id);  // field only
         kiln::gl::bindTexture(program, "u_lightShadows", ctx.input("light_shadows").id);  // punctual lights only
         bindSums(ctx, program, GL_READ_WRITE);
-        glUniform1i(glGetUniformLocation(program, "u_res"), res);
+        glUniform1i(glGetUniformLocation(program, "u_res"), std::max({res.x, res.y, res.z}));
+        glUniform3i(glGetUniformLocation(program, "u_grid"), res.x, res.y, res.z);
         glUniform1f(glGetUniformLocation(program, "u_shadowBias"), ctx.getFloat("shadow_bias"));
     }
 
@@ -369,7 +376,7 @@ private:
     // emitters). One program with a branch between the two ran the fireballs' lighting for
     // every particle (llvmpipe runs an `if` for every lane), dearer than the two programs
     // apart. `groupSize`: the program's KILN_SPLAT_GROUP.
-    static void splat(kiln::PassContext& ctx, GLuint splatter, uint32_t groupSize, int res,
+    static void splat(kiln::PassContext& ctx, GLuint splatter, uint32_t groupSize, glm::ivec3 res,
                       kiln::SceneCategory spheres) {
         const kiln::SceneView& scene = ctx.scene();
         const uint32_t count = scene.count(spheres);
@@ -386,7 +393,7 @@ private:
     // fireballs exactly), resolved into `fire` and its mips; then from them and the
     // fireballs `lamp_transmittance`, ready for the resolve's and cone_trace's lookups.
     static void coverFire(kiln::PassContext& ctx, GLuint coverer, GLuint resolver, GLuint mipper, GLuint lighter,
-                          int res) {
+                          glm::ivec3 res) {
         const kiln::SceneView& scene = ctx.scene();
         const uint32_t count = scene.count(kiln::kSceneParticles);
         if (count > 0) {
@@ -394,7 +401,7 @@ private:
             bindSums(ctx, coverer, GL_READ_WRITE);
             glUniform1ui(glGetUniformLocation(coverer, "u_first"), scene.firstInstance(kiln::kSceneParticles));
             glUniform1ui(glGetUniformLocation(coverer, "u_sphereCount"), count);
-            glUniform1i(glGetUniformLocation(coverer, "u_res"), res);
+            glUniform3i(glGetUniformLocation(coverer, "u_grid"), res.x, res.y, res.z);
             glDispatchCompute((count + 63) / 64, 1, 1);
         }
         const kiln::TextureRef& fire = ctx.output("fire");
@@ -402,8 +409,7 @@ private:
         glUseProgram(resolver);
         bindSums(ctx, resolver, GL_READ_ONLY);
         kiln::gl::bindImage(resolver, "u_fire", fire.id, 0, true, GL_WRITE_ONLY, GL_R16F);
-        const GLuint groups = GLuint((res + 3) / 4);
-        glDispatchCompute(groups, groups, groups);
+        glDispatchCompute(groups(res.x), groups(res.y), groups(res.z));
         mipFire(ctx, mipper);
         // The lamp's transmittance on its grid, through the cover and the fireballs.
         glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
@@ -413,8 +419,7 @@ private:
         kiln::gl::bindImage(lighter, "u_transmittance", light.id, 0, true, GL_WRITE_ONLY, GL_R16F);
         glUniform1i(glGetUniformLocation(lighter, "u_firstFireball"), GLint(scene.firstInstance(kiln::kSceneGlowingSpheres)));
         glUniform1i(glGetUniformLocation(lighter, "u_fireballCount"), GLint(scene.count(kiln::kSceneGlowingSpheres)));
-        const GLuint lightGroups = GLuint((light.width + 3) / 4);
-        glDispatchCompute(lightGroups, lightGroups, lightGroups);
+        glDispatchCompute(groups(light.width), groups(light.height), groups(light.depth));
         glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
     }
 
@@ -426,21 +431,23 @@ private:
             glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
             kiln::gl::bindImage(program, "u_finer", fire.id, level - 1, true, GL_READ_ONLY, GL_R16F);
             kiln::gl::bindImage(program, "u_coarser", fire.id, level, true, GL_WRITE_ONLY, GL_R16F);
-            const GLuint groups = GLuint((std::max(1, fire.width >> level) + 3) / 4);
-            glDispatchCompute(groups, groups, groups);
+            glDispatchCompute(groups(std::max(1, fire.width >> level)), groups(std::max(1, fire.height >> level)),
+                              groups(std::max(1, fire.depth >> level)));
         }
     }
 
     // The tumblers from their exact shape (tumbler_mode splat): one invocation per voxel of
     // the cube around each one's bounding ball (half its height plus its lower radius
     // from the axis' midpoint), a row of groups per tumbler.
-    static void splatTumblerShapes(kiln::PassContext& ctx, GLuint program, int res) {
+    static void splatTumblerShapes(kiln::PassContext& ctx, GLuint program, glm::ivec3 res) {
         const kiln::SceneView& scene = ctx.scene();
         const uint32_t tumblers = scene.count(kiln::kSceneRoundCones);
         if (tumblers == 0) return;
         const glm::vec4& shape = scene.frame.roundCone;
-        const float reach = 0.5f * shape.w + shape.x, voxel = 2.0f * scene.frame.voxelVolume.w / float(res);
-        const int side = std::min(res, int(std::ceil(2.0f * reach / voxel)) + 1);  // +1: the cube starts at a floor
+        // The smallest cell side: the cube of cells around the ball covers it on every axis.
+        const glm::vec3 cell = 2.0f * scene.frame.voxelVolume.w * glm::vec3(scene.frame.voxelExtent) / glm::vec3(res);
+        const float reach = 0.5f * shape.w + shape.x, voxel = std::min({cell.x, cell.y, cell.z});
+        const int side = std::min(std::max({res.x, res.y, res.z}), int(std::ceil(2.0f * reach / voxel)) + 1);  // +1: the cube starts at a floor
         useSurfaceProgram(ctx, program, res);
         glUniform1ui(glGetUniformLocation(program, "u_first"), scene.firstInstance(kiln::kSceneRoundCones));
         glUniform1i(glGetUniformLocation(program, "u_side"), side);
@@ -448,7 +455,7 @@ private:
     }
 
     // 4: the sums' averages into the outputs.
-    static void resolveSums(kiln::PassContext& ctx, GLuint resolve, const kiln::TextureRef& out, int res) {
+    static void resolveSums(kiln::PassContext& ctx, GLuint resolve, const kiln::TextureRef& out, glm::ivec3 res) {
         glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
         glUseProgram(resolve);
         bindSums(ctx, resolve, GL_READ_ONLY);
@@ -456,9 +463,9 @@ private:
         kiln::gl::bindImage(resolve, "u_radiance", out.id, 0, true, GL_WRITE_ONLY, GL_RGBA16F);
         kiln::gl::bindImage(resolve, "u_albedo", ctx.output("albedo").id, 0, true, GL_WRITE_ONLY, GL_RGBA8);
         kiln::gl::bindImage(resolve, "u_normal", ctx.output("normal").id, 0, true, GL_WRITE_ONLY, GL_RGBA16F);
-        const GLuint groups = GLuint((res + 3) / 4);
-        glDispatchCompute(groups, groups, groups);
+        glDispatchCompute(groups(res.x), groups(res.y), groups(res.z));
     }
+    static GLuint groups(int n) { return GLuint((n + 3) / 4); }  // 4³ workgroups
 
     // The accumulators: one volume, kSumChannels grids along x (shaders/voxelize/sums.glsl).
     static constexpr int kSumChannels = 14;
@@ -494,8 +501,9 @@ private:
     struct StaticKey {
         uint64_t lampVersion = 0, lightVersion = 0, boxVersion = 0, meshesVersion = 0;
         glm::vec4 ringsLight{-1.0f}, ringsDark{-1.0f};  // the floor's grain (its albedo)
+        glm::vec4 volume{0.0f}, extent{0.0f};
         GLuint texture = 0, program = 0, recorder = 0;
-        int resolution = 0;
+        glm::ivec3 grid{0};
         float emission = -1.0f;
         bool conservative = false;
         bool operator==(const StaticKey&) const = default;

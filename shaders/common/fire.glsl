@@ -44,7 +44,8 @@ float discOverlap(float a, float b, float c) {
 }
 
 float fireTransmittance(vec3 p, vec3 n) {
-    float voxel = kilnVoxelSize(float(textureSize(u_fire, 0).x));
+    ivec3 cells = textureSize(u_fire, 0);
+    float voxel = kilnVoxelSize(float(max(cells.x, max(cells.y, cells.z))));  // along the longest side
     vec3 origin = p + n * (0.5 * voxel);
     vec3 toLamp = lightEye() - origin;
     float dist = length(toLamp);

@@ -23,16 +23,25 @@ layout(std140, binding = 0) uniform KilnFrame {
     uvec4 u_closedFaces; // x: the voxel volume's faces with a wall, bit 2a: −axis a, 2a+1: +axis a
     vec4 u_sceneMin;     // the scene's bounds, world space
     vec4 u_sceneMax;
-    vec4 u_voxelVolume;  // the voxel passes' cube: xyz centre, w half side (world)
+    vec4 u_voxelVolume;  // the voxel passes' box: xyz centre, w half its longest side (world)
+    vec4 u_voxelExtent;  // xyz: the box's half extent per axis ÷ u_voxelVolume.w (the longest 1)
     uvec4 u_punctualCount;  // x: u_punctual[0 .. x) are lights
     KilnPunctualLight u_punctual[kMaxPunctualLights];
 };
 
-// The voxel volume: world space ↔ volume space (the cube as [-1,1]³, where the voxel
-// passes rasterize, splat and trace) ↔ texture space ([0,1]³). For a scene of [-1,1]³
-// every map is the identity, exactly.
+// The voxel volume: world space ↔ volume space (moved to the box's centre and divided
+// by half its longest side: the box is [-e, e] with e = u_voxelExtent.xyz, one scale on
+// every axis, where cones are traced) ↔ grid space (volume space ÷ e: the box as
+// [-1,1]³, where the voxel passes rasterize and splat) ↔ texture space ([0,1]³). For a
+// scene of [-1,1]³ every map is the identity, exactly.
 vec3 kilnWorldToVolume(vec3 p) { return (p - u_voxelVolume.xyz) / u_voxelVolume.w; }
 vec3 kilnVolumeToWorld(vec3 q) { return q * u_voxelVolume.w + u_voxelVolume.xyz; }
-vec3 kilnVolumeTexcoord(vec3 p) { return kilnWorldToVolume(p) * 0.5 + 0.5; }
-// A voxel's side in world units on a grid of `res` per side.
+vec3 kilnVolumeToGrid(vec3 q) { return q / u_voxelExtent.xyz; }
+vec3 kilnWorldToGrid(vec3 p) { return kilnVolumeToGrid(kilnWorldToVolume(p)); }
+vec3 kilnGridToWorld(vec3 g) { return kilnVolumeToWorld(g * u_voxelExtent.xyz); }
+vec3 kilnVolumeTexcoord(vec3 p) { return kilnWorldToGrid(p) * 0.5 + 0.5; }
+// A voxel's side in world units along the longest axis of a grid of `res` there (the
+// others' are within √2 of it: kiln::voxelGridShift).
 float kilnVoxelSize(float res) { return 2.0 * u_voxelVolume.w / res; }
+// A cell's sides in world units on a grid of `grid` cells per axis.
+vec3 kilnCellSize(vec3 grid) { return 2.0 * u_voxelVolume.w * u_voxelExtent.xyz / grid; }

@@ -9,9 +9,9 @@ uniform float u_diameterOffset;   // × each sample's diameter, along the normal
 const vec4 kSchedule[KILN_CONE_STEPS] = vec4[](KILN_CONE_SCHEDULE);
 
 // Front-to-back composite along one cone, in volume space (common/frame.glsl: the voxel
-// volume as [-1,1]³, where the step schedule is laid out): rgb = radiance arriving
-// (premultiplied), a = opacity met. Samples outside the box count as empty (the walls sit in the
-// outermost voxels, so nothing is lost).
+// volume as [-e, e], one scale on every axis, where the step schedule is laid out): rgb =
+// radiance arriving (premultiplied), a = opacity met. Samples outside the box count as
+// empty (the walls sit in the outermost voxels, so nothing is lost).
 // tile: the cone's index in the fixed set (KILN_HAS_FIXED_CONES), else unused.
 vec4 traceCone(vec3 origin, vec3 n, vec3 dir, int tile) {
     vec4 acc = vec4(0.0);
@@ -23,9 +23,9 @@ vec4 traceCone(vec3 origin, vec3 n, vec3 dir, int tile) {
         vec3 p = origin + n * (u_diameterOffset * kSchedule[i].y) + dir * kSchedule[i].x;
         // No early exit: with the loop unrolled, a branch around the lookups cost more
         // than it saved on llvmpipe (measured).
-        vec4 s = sampleVoxels(p * 0.5 + 0.5, dir, tile, kSchedule[i].z);
-        // Past the box (the sample no longer overlaps [-1,1]³): nothing there.
-        s *= all(lessThanEqual(abs(p), vec3(1.0 + 0.5 * kSchedule[i].y))) ? 1.0 : 0.0;
+        vec4 s = sampleVoxels(kilnVolumeToGrid(p) * 0.5 + 0.5, dir, tile, kSchedule[i].z);
+        // Past the box (the sample no longer overlaps [-e, e]): nothing there.
+        s *= all(lessThanEqual(abs(p), u_voxelExtent.xyz + 0.5 * kSchedule[i].y)) ? 1.0 : 0.0;
         // Opacity of a slab `spacing` long instead of one diameter.
         float a = 1.0 - pow(max(1.0 - s.a, 1e-6), kSchedule[i].w);
         s.rgb *= a / max(s.a, 1e-6);

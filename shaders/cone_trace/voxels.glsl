@@ -9,7 +9,9 @@
 //   neither               the isotropic chain.
 //
 // Needs: u_voxels (iso chain, level 0 = voxelize.radiance), u_aniso (the octant atlas)
-// or u_fixedCones (the tile strip), u_voxelRes (voxels per side at level 0).
+// or u_fixedCones (the tile strip), u_voxelDims (voxels per axis at level 0). The
+// directional chains end where the grid's shortest axis is one octant voxel across: a
+// wider cone reads their top level.
 //
 // Past a face of the box, a lookup reads what the face holds: a wall (in the outermost
 // voxels) goes on as a wall, so a cone that reaches it stops there whatever its width;
@@ -22,7 +24,8 @@
 layout(binding = 2) uniform sampler3D u_voxels;
 layout(binding = 3) uniform sampler3D u_aniso;
 layout(binding = 6) uniform sampler3D u_fixedCones;
-uniform float u_voxelRes;
+uniform float u_voxelRes;   // voxels along the longest axis (the cone schedule's unit)
+uniform vec3 u_voxelDims;   // voxels per axis
 
 #if KILN_HAS_FIXED_CONES
 #include "common/fixed_cones.glsl"
@@ -31,13 +34,17 @@ uniform float u_voxelRes;
 // Clamped half a texel inside one directional block (an octant or a tile) whose side at
 // level 1 is res/2, at atlas level al: a lookup never blends in its neighbour.
 vec3 insideBlock(vec3 p01, float al) {
-    float side = max(0.5 * u_voxelRes / exp2(ceil(al)), 1.0);  // the coarser level used
-    return clamp(p01, vec3(0.5 / side), vec3(1.0 - 0.5 / side));
+    vec3 side = max(0.5 * u_voxelDims / exp2(ceil(al)), vec3(1.0));  // the coarser level used
+    return clamp(p01, 0.5 / side, 1.0 - 0.5 / side);
 }
 
-// The share of a lookup at p01 on a level of `side` texels that lies inside the box or
-// behind a wall: trilinear filtering with an empty border on the open faces.
-float insideBox(vec3 p01, float side) {
+// The directional chains' top atlas level (passes/voxel_mip: the shortest axis's octant
+// one voxel across).
+float atlasTop() { return log2(min(u_voxelDims.x, min(u_voxelDims.y, u_voxelDims.z))) - 1.0; }
+
+// The share of a lookup at p01 on a level of `side` texels per axis that lies inside the
+// box or behind a wall: trilinear filtering with an empty border on the open faces.
+float insideBox(vec3 p01, vec3 side) {
     uint walls = u_closedFaces.x;
     vec3 wallBelow = vec3(uvec3(walls, walls >> 2, walls >> 4) & 1u);
     vec3 wallAbove = vec3(uvec3(walls >> 1, walls >> 3, walls >> 5) & 1u);
@@ -53,11 +60,11 @@ float insideBox(vec3 p01, float side) {
 vec4 sampleVoxels(vec3 p01, vec3 d, int tile, float lod) {
 #if KILN_HAS_ANISO || KILN_HAS_FIXED_CONES
     vec4 base = vec4(0.0);
-    if (lod < 1.0) base = textureLod(u_voxels, p01, 0.0) * insideBox(p01, u_voxelRes);
+    if (lod < 1.0) base = textureLod(u_voxels, p01, 0.0) * insideBox(p01, u_voxelDims);
     if (lod <= 0.0) return base;
-    float al = max(lod - 1.0, 0.0);  // atlas level
+    float al = clamp(lod - 1.0, 0.0, atlasTop());  // atlas level
     vec3 q = insideBlock(p01, al);
-    float inside = insideBox(p01, max(0.5 * u_voxelRes / exp2(al), 1.0));
+    float inside = insideBox(p01, max(0.5 * u_voxelDims / exp2(al), vec3(1.0)));
 #if KILN_HAS_FIXED_CONES
     vec4 s = textureLod(u_fixedCones, vec3((float(tile) + q.x) / float(kFixedConeTiles), q.y, q.z), al) * inside;
 #else
@@ -70,6 +77,6 @@ vec4 sampleVoxels(vec3 p01, vec3 d, int tile, float lod) {
 #endif
     return lod < 1.0 ? mix(base, s, lod) : s;
 #else
-    return textureLod(u_voxels, p01, lod) * insideBox(p01, max(u_voxelRes / exp2(lod), 1.0));
+    return textureLod(u_voxels, p01, lod) * insideBox(p01, max(u_voxelDims / exp2(lod), vec3(1.0)));
 #endif
 }

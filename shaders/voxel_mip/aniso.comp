@@ -30,7 +30,7 @@ layout(rgba16f, binding = 3) uniform writeonly image3D u_fixed;  // kFixedConeTi
 #ifndef KILN_ANISO_FACING
 #define KILN_ANISO_FACING 0
 #endif
-uniform int u_size;      // parent voxels per side at this level
+uniform ivec3 u_size;    // parent voxels per axis at this level (an octant's)
 
 ivec3 octant(int i) { return ivec3(i & 1, (i >> 1) & 1, i >> 2); }
 
@@ -80,7 +80,7 @@ vec4 facing(vec4 c, vec3 m, vec3 d) {
 
 void main() {
     ivec3 v = ivec3(gl_GlobalInvocationID);
-    if (any(greaterThanEqual(v, ivec3(u_size)))) return;
+    if (any(greaterThanEqual(v, u_size))) return;
     vec4 face[6];
 #if KILN_ANISO_FROM_BASE && KILN_ANISO_FACING > 0
     {
@@ -114,7 +114,7 @@ void main() {
         vec3 d = fixedConeDirection(t);
         vec3 w = d * d;
         vec4 r = w.x * face[d.x < 0.0 ? 1 : 0] + w.y * face[d.y < 0.0 ? 3 : 2] + w.z * face[d.z < 0.0 ? 5 : 4];
-        imageStore(u_fixed, v + ivec3(t * u_size, 0, 0), r);
+        imageStore(u_fixed, v + ivec3(t * u_size.x, 0, 0), r);
     }
 #endif
 }

@@ -70,7 +70,7 @@ vec3 gatherBlock(ivec3 block) {
         ivec3 v = voxelOf(block, i);
         if (!reflects(texelFetch(u_emitted, v, 0), texelFetch(u_albedo, v, 0).rgb)) continue;
         normalSum += texelFetch(u_normal, v, 0).xyz;
-        centreSum += (vec3(v) + 0.5) / u_voxelRes * 2.0 - 1.0;
+        centreSum += ((vec3(v) + 0.5) / u_voxelDims * 2.0 - 1.0) * u_voxelExtent.xyz;  // volume space
         surfaces += 1.0;
     }
     if (surfaces == 0.0) return vec3(0.0);
@@ -130,8 +130,7 @@ void main() {
     ivec3 block = ivec3(code & 1023u, (code >> 10) & 1023u, code >> 20);
 #else
     ivec3 block = ivec3(gl_GlobalInvocationID);
-    int res = int(u_voxelRes);
-    if (any(greaterThanEqual(block * kBlock, ivec3(res)))) return;
+    if (any(greaterThanEqual(block * kBlock, ivec3(u_voxelDims)))) return;
 #endif
 #if KILN_BOUNCE_STEP != 2
     vec3 gathered = gatherBlock(block);

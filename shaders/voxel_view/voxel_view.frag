@@ -1,6 +1,6 @@
 #version 450 core
 // Ray-march the voxels at one mip level: a 3D DDA (Amanatides & Woo) over the level's
-// grid over the voxel volume (in volume space, [-1,1]³), compositing premultiplied colour front to back until opaque.
+// grid over the voxel volume (in grid space, [-1,1]³), compositing premultiplied colour front to back until opaque.
 #include "common/frame.glsl"
 
 in vec2 v_uv;
@@ -13,23 +13,23 @@ uniform float u_minOpacity;
 void main() {
     vec4 nearP = u_invViewProj * vec4(v_uv * 2.0 - 1.0, -1.0, 1.0);
     vec4 farP = u_invViewProj * vec4(v_uv * 2.0 - 1.0, 1.0, 1.0);
-    vec3 ro = kilnWorldToVolume(nearP.xyz / nearP.w);
-    vec3 rd = normalize(kilnWorldToVolume(farP.xyz / farP.w) - ro);
+    vec3 ro = kilnWorldToGrid(nearP.xyz / nearP.w);
+    vec3 rd = normalize(kilnWorldToGrid(farP.xyz / farP.w) - ro);
     vec3 inv = 1.0 / rd;
     vec3 t0 = (vec3(-1.0) - ro) * inv, t1 = (vec3(1.0) - ro) * inv;
     float tEnter = max(max(min(t0.x, t1.x), min(t0.y, t1.y)), max(min(t0.z, t1.z), 0.0));
     float tExit = min(min(max(t0.x, t1.x), max(t0.y, t1.y)), max(t0.z, t1.z));
     vec4 acc = vec4(0.0);
     if (tEnter < tExit) {
-        int n = textureSize(u_voxels, u_mip).x;
-        float cell = 2.0 / float(n);
+        ivec3 n = textureSize(u_voxels, u_mip);
+        vec3 cell = 2.0 / vec3(n);
         vec3 p = ro + rd * (tEnter + 1e-4);
-        ivec3 c = clamp(ivec3(floor((p + 1.0) / cell)), ivec3(0), ivec3(n - 1));
+        ivec3 c = clamp(ivec3(floor((p + 1.0) / cell)), ivec3(0), n - 1);
         ivec3 stepDir = ivec3(sign(rd));
         vec3 next = (vec3(c + max(stepDir, ivec3(0))) * cell - 1.0 - ro) * inv;
         vec3 delta = abs(cell * inv);
         for (int i = 0; i < 3 * 256 && acc.a < 0.99; ++i) {
-            if (any(lessThan(c, ivec3(0))) || any(greaterThanEqual(c, ivec3(n)))) break;
+            if (any(lessThan(c, ivec3(0))) || any(greaterThanEqual(c, n))) break;
             vec4 s = texelFetch(u_voxels, c, u_mip);
             if (s.a > u_minOpacity) {
                 // Show the voxel's own colour (un-premultiplied) as a solid box.

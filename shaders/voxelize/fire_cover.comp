@@ -22,22 +22,21 @@ layout(local_size_x = 64) in;
 
 uniform uint u_first;
 uniform uint u_sphereCount;
-uniform int u_res;  // voxels per side
+uniform ivec3 u_grid;  // voxels per axis
 
 void main() {
     if (gl_GlobalInvocationID.x >= u_sphereCount) return;
     KilnInstance inst = kiln_instances[u_first + gl_GlobalInvocationID.x];
     vec3 centre = kilnSphereCentre(inst);
     float radius = kilnSphereRadius(inst);
-    // In volume space (the voxel volume as [-1,1]³), then in voxel units: the cube
-    // [lo, hi] and the voxels it overlaps.
-    centre = kilnWorldToVolume(centre);
-    radius /= u_voxelVolume.w;
-    float voxel = 2.0 / float(u_res);
-    vec3 lo = (centre - radius + 1.0) / voxel, hi = (centre + radius + 1.0) / voxel;
-    ivec3 first = max(ivec3(floor(lo)), ivec3(0)), last = min(ivec3(floor(hi)), ivec3(u_res - 1));
-    float side = max(hi.x - lo.x, 1e-6);
-    float crossSection = 3.14159265 * radius * radius / (voxel * voxel);  // σ / h²: μ·h summed over a voxel's worth
+    // In voxel units: the cube [lo, hi] around the sphere and the voxels it overlaps.
+    vec3 voxel = kilnCellSize(vec3(u_grid));  // world
+    vec3 lo = kilnVolumeTexcoord(centre - radius) * vec3(u_grid), hi = kilnVolumeTexcoord(centre + radius) * vec3(u_grid);
+    ivec3 first = max(ivec3(floor(lo)), ivec3(0)), last = min(ivec3(floor(hi)), u_grid - 1);
+    vec3 side = max(hi - lo, vec3(1e-6));
+    // σ / h²: μ·h summed over a voxel's worth (h along the longest axis; the cells are
+    // cubes wherever the fire is, the Cornell box's grid).
+    float crossSection = 3.14159265 * radius * radius / (voxel.x * voxel.x);
     for (int z = first.z; z <= last.z; ++z)
         for (int y = first.y; y <= last.y; ++y)
             for (int x = first.x; x <= last.x; ++x) {

@@ -29,8 +29,8 @@ void main() {
     ivec3 size = imageSize(u_transmittance);
     if (gl_LocalInvocationIndex == 0u) s_count = 0u;
     barrier();
-    vec3 blockLo = kilnVolumeToWorld(vec3(gl_WorkGroupID * gl_WorkGroupSize) / vec3(size) * 2.0 - 1.0);
-    vec3 blockHi = kilnVolumeToWorld(vec3((gl_WorkGroupID + 1u) * gl_WorkGroupSize) / vec3(size) * 2.0 - 1.0);
+    vec3 blockLo = kilnGridToWorld(vec3(gl_WorkGroupID * gl_WorkGroupSize) / vec3(size) * 2.0 - 1.0);
+    vec3 blockHi = kilnGridToWorld(vec3((gl_WorkGroupID + 1u) * gl_WorkGroupSize) / vec3(size) * 2.0 - 1.0);
     vec3 blockCentre = 0.5 * (blockLo + blockHi);
     float thickness = max(0.5 * length(blockHi - blockLo), u_lightPos.w);
     vec3 axis = u_lightPos.xyz - blockCentre;
@@ -46,7 +46,7 @@ void main() {
     barrier();
     ivec3 v = ivec3(gl_GlobalInvocationID);
     if (any(greaterThanEqual(v, size))) return;
-    vec3 node = kilnVolumeToWorld((vec3(v) + 0.5) / vec3(size) * 2.0 - 1.0);
+    vec3 node = kilnGridToWorld((vec3(v) + 0.5) / vec3(size) * 2.0 - 1.0);
     vec3 towards = lightEye() - node;
     vec3 n = dot(towards, towards) > 1e-8 ? normalize(towards) : vec3(0.0, 1.0, 0.0);
     imageStore(u_transmittance, v, vec4(fireTransmittance(node, n)));

@@ -33,9 +33,9 @@ void main() {
     KilnInstance inst = kiln_instances[u_first + gl_GlobalInvocationID.x];
     vec3 centre = kilnSphereCentre(inst);
     float radius = kilnSphereRadius(inst);
-    float voxel = kilnVoxelSize(float(u_res));
-    ivec3 lo = max(ivec3(floor(kilnVolumeTexcoord(centre - radius) * float(u_res))), ivec3(0));
-    ivec3 hi = min(ivec3(floor(kilnVolumeTexcoord(centre + radius) * float(u_res))), ivec3(u_res - 1));
+    vec3 voxel = kilnCellSize(vec3(u_grid));
+    ivec3 lo = max(ivec3(floor(kilnVolumeTexcoord(centre - radius) * vec3(u_grid))), ivec3(0));
+    ivec3 hi = min(ivec3(floor(kilnVolumeTexcoord(centre + radius) * vec3(u_grid))), u_grid - 1);
 #if KILN_SPLAT_LIT
     float flux = u_sphereFlux ? sphereFluxScale(radius) : 1.0;
     uvec3 emitted = toFixedRadiance(inst.emissive.rgb * u_fireballEmission * flux);
@@ -45,7 +45,7 @@ void main() {
     for (int z = lo.z; z <= hi.z; ++z)
         for (int y = lo.y; y <= hi.y; ++y)
             for (int x = lo.x; x <= hi.x; ++x) {
-                vec3 cubeLo = kilnVolumeToWorld(vec3(x, y, z) * (2.0 / float(u_res)) - 1.0);
+                vec3 cubeLo = kilnGridToWorld(vec3(x, y, z) * (2.0 / vec3(u_grid)) - 1.0);
                 vec3 cubeHi = cubeLo + voxel;
                 float nearest = distance(clamp(centre, cubeLo, cubeHi), centre);
                 float farthest = length(max(abs(cubeLo - centre), abs(cubeHi - centre)));

@@ -12,8 +12,8 @@ layout(r32ui, binding = 0) uniform coherent uimage3D u_sums;
 const int kSumR = 0, kSumG = 1, kSumB = 2, kCount = 3, kAlbedoR = 4, kAlbedoG = 5, kAlbedoB = 6, kNormalX = 7,
           kNormalY = 8, kNormalZ = 9, kFireCover = 10, kEmitR = 11, kEmitG = 12, kEmitB = 13;
 
-// Voxel v's texel of one channel (the grid's side: the volume's height).
-ivec3 sumTexel(ivec3 v, int channel) { return ivec3(v.x + channel * imageSize(u_sums).y, v.yz); }
+// Voxel v's texel of one channel (the grid's width: the image's over the channels).
+ivec3 sumTexel(ivec3 v, int channel) { return ivec3(v.x + channel * (imageSize(u_sums).x / (kEmitB + 1)), v.yz); }
 void addToSum(ivec3 v, int channel, uint value) { imageAtomicAdd(u_sums, sumTexel(v, channel), value); }
 uint loadSum(ivec3 v, int channel) { return imageLoad(u_sums, sumTexel(v, channel)).r; }
 

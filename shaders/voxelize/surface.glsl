@@ -10,7 +10,8 @@ layout(binding = 0) uniform sampler2D u_shadowMap;
 #include "common/lamp_field.glsl"
 layout(binding = 1) uniform sampler2D u_lampField;
 #endif
-uniform int u_res;          // voxels per side
+uniform int u_res;          // voxels along the grid's longest side
+uniform ivec3 u_grid;       // voxels per axis
 uniform float u_shadowBias;
 uniform bool u_unshadowed;  // the lamp dome (voxelize.cpp): the emitter, never in a shadow
 

@@ -57,15 +57,15 @@ void main() {
     KilnInstance inst = kiln_instances[u_first + gl_GlobalInvocationID.y];
     mat4 m = inst.model;
     mat3 toLocal = transpose(mat3(m));  // rigid
-    float voxel = kilnVoxelSize(float(u_res));
+    vec3 voxel = kilnCellSize(vec3(u_grid));
     // The bounding ball: the axis' midpoint, half the height plus the lower radius.
     vec3 mid = (m * vec4(0.0, 0.5 * u_roundCone.w, 0.0, 1.0)).xyz;
     float reach = 0.5 * u_roundCone.w + u_roundCone.x;
-    ivec3 lo = ivec3(floor(kilnVolumeTexcoord(mid - reach) * float(u_res)));
+    ivec3 lo = ivec3(floor(kilnVolumeTexcoord(mid - reach) * vec3(u_grid)));
     ivec3 v = lo + ivec3(cell % u_side, (cell / u_side) % u_side, cell / (u_side * u_side));
-    if (any(lessThan(v, ivec3(0))) || any(greaterThanEqual(v, ivec3(u_res)))) return;
+    if (any(lessThan(v, ivec3(0))) || any(greaterThanEqual(v, u_grid))) return;
 
-    vec3 cubeLo = kilnVolumeToWorld(vec3(v) * (2.0 / float(u_res)) - 1.0);
+    vec3 cubeLo = kilnGridToWorld(vec3(v) * (2.0 / vec3(u_grid)) - 1.0);
     vec3 gradient;
     bool inside = false, outside = false;
     for (int c = 0; c < 8; ++c) {

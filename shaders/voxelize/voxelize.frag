@@ -36,7 +36,7 @@ void main() {
     // derivative is undefined - llvmpipe only masks a discarded lane and still gave the
     // right span, NVIDIA's driver does not, and its tumblers' shells lost voxels where
     // their surfaces turn steep (the indirect light under them far brighter than llvmpipe's).
-    vec3 q = kilnWorldToVolume(v_world);
+    vec3 q = kilnWorldToGrid(v_world);
     float depth = v_axis == 0 ? q.x : v_axis == 1 ? q.y : q.z;
     float span = 0.5 * (abs(dFdx(depth)) + abs(dFdy(depth)));
 
@@ -53,9 +53,11 @@ void main() {
 
     float zLo = clamp(depth - span, v_depthRange.x, v_depthRange.y);
     float zHi = clamp(depth + span, v_depthRange.x, v_depthRange.y);
-    int k0 = clamp(int(floor((zLo * 0.5 + 0.5) * float(u_res))), 0, u_res - 1);
-    int k1 = clamp(int(floor((zHi * 0.5 + 0.5) * float(u_res))), 0, u_res - 1);
-    ivec2 ij = clamp(ivec2(px), ivec2(0), ivec2(u_res - 1));
+    // The viewport's columns and the layers along the axis (voxelize.geom's swizzle).
+    ivec3 cells = v_axis == 0 ? u_grid.yzx : v_axis == 1 ? u_grid.zxy : u_grid;
+    int k0 = clamp(int(floor((zLo * 0.5 + 0.5) * float(cells.z))), 0, cells.z - 1);
+    int k1 = clamp(int(floor((zHi * 0.5 + 0.5) * float(cells.z))), 0, cells.z - 1);
+    ivec2 ij = clamp(ivec2(px), ivec2(0), cells.xy - 1);
     int kLast = min(k1, k0 + 2);
 #if KILN_RECORD_STATIC
     // A static surface: everything but its lamp light now, the fragment kept for

@@ -680,7 +680,7 @@ TEST_CASE("the atrium, 37 m across: the sun on the court as E·ρ/π, the galler
     CHECK(depth->depthFar > kCameraFar);
     const glm::vec2 uv = (glm::vec2(rig.pixelOf(court)) + 0.5f) / float(kSize);
     const app::PixelTrace trace = app::tracePixel(rig.app.runtime(), glm::inverse(rig.app.viewProj()),
-                                                  rig.app.voxelVolume(), uv);
+                                                  rig.app.voxelVolume(), rig.app.voxelExtent(), uv);
     REQUIRE(trace.world);
     INFO("traced " << trace.world->x << " " << trace.world->y << " " << trace.world->z);
     CHECK(std::abs(trace.world->y) < 0.01f);  // on the floor

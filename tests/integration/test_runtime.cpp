@@ -386,7 +386,7 @@ TEST_CASE("a pixel traced through the graph: each 2D texture where the pixel fal
     Fixture f(kSize);
     f.app.frame();
     const glm::vec2 uv((kX + 0.5f) / kSize, (kY + 0.5f) / kSize);
-    const app::PixelTrace trace = app::tracePixel(f.app.runtime(), glm::inverse(f.app.viewProj()), f.app.voxelVolume(), uv);
+    const app::PixelTrace trace = app::tracePixel(f.app.runtime(), glm::inverse(f.app.viewProj()), f.app.voxelVolume(), f.app.voxelExtent(), uv);
 
     // The world position, another way: the camera's ray through that pixel meets the back
     // wall z = −1. Tolerance 2 mm: depth quantisation is ~0.1 mm here; half a pixel off

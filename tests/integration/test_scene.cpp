@@ -866,7 +866,7 @@ TEST_CASE("composite fireball_light analytic: a fireball above the floor adds al
     const glm::ivec2 px(rig.pixelOf({0.0f, -1.0f, 0.3f}, 160));
     const glm::vec3 without = floorRadiance("voxels", px), with = floorRadiance("analytic", px);
     // Where that pixel is (the trace's world position, tested against a ray) and what it is.
-    const app::PixelTrace t = app::tracePixel(rig.app.runtime(), glm::inverse(rig.app.viewProj()), rig.app.voxelVolume(),
+    const app::PixelTrace t = app::tracePixel(rig.app.runtime(), glm::inverse(rig.app.viewProj()), rig.app.voxelVolume(), rig.app.voxelExtent(),
                                               (glm::vec2(px) + 0.5f) / 160.0f);
     REQUIRE(t.world);
     const TextureRef* albedoTexture = rig.app.runtime().findTexture("gbuffer", "albedo");

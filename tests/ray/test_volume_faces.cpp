@@ -40,6 +40,11 @@ struct Walls {
 
 const glm::vec3 kLo(-2.0f), kHi(2.0f);  // the scenes' bounds: the volume's
 
+// A cube volume (xyz centre, w half its side), `depth` on every axis.
+uint32_t closedCubeFaces(const RayMeshData& meshes, glm::vec4 volume, glm::vec3 lo, glm::vec3 hi, float depth) {
+    return closedVolumeFaces(meshes, glm::vec3(volume), glm::vec3(volume.w), lo, hi, glm::vec3(depth));
+}
+
 }  // namespace
 
 TEST_CASE("a room of one-sided walls at the volume's faces closes all six, one left out opens its face",
@@ -48,14 +53,14 @@ TEST_CASE("a room of one-sided walls at the volume's faces closes all six, one l
     Walls room;
     for (int axis = 0; axis < 3; ++axis)
         for (float side : {-1.0f, 1.0f}) room.square(axis, 1.97f * side, -2.0f, 2.0f, -side);  // facing in
-    CHECK(closedVolumeFaces(room.data(), volume, kLo, kHi, 0.125f) == 0x3Fu);
+    CHECK(closedCubeFaces(room.data(), volume, kLo, kHi, 0.125f) == 0x3Fu);
     Walls open;
     for (int axis = 0; axis < 3; ++axis)
         for (float side : {-1.0f, 1.0f})
             if (!(axis == 2 && side > 0)) open.square(axis, 1.97f * side, -2.0f, 2.0f, -side);
-    CHECK(closedVolumeFaces(open.data(), volume, kLo, kHi, 0.125f) == 0x1Fu);  // +z open, as the box's front
+    CHECK(closedCubeFaces(open.data(), volume, kLo, kHi, 0.125f) == 0x1Fu);  // +z open, as the box's front
     // Walls deeper in than `depth` do not close the faces (the voxels there are empty).
-    CHECK(closedVolumeFaces(room.data(), volume, kLo, kHi, 0.01f) == 0u);
+    CHECK(closedCubeFaces(room.data(), volume, kLo, kHi, 0.01f) == 0u);
     // A low room in a taller volume: its side walls close the side faces over the part
     // of them the room covers (above it the outermost voxels are empty either way).
     Walls low;
@@ -65,8 +70,8 @@ TEST_CASE("a room of one-sided walls at the volume's faces closes all six, one l
             low.square(axis, 1.97f * side, -2.0f, 2.0f, -side);
             for (size_t k = first; k < low.positions.size(); ++k) low.positions[k].y = low.positions[k].y < 0 ? -2.0f : -1.0f;
         }
-    CHECK(closedVolumeFaces(low.data(), volume, kLo, glm::vec3(2.0f, -1.0f, 2.0f), 0.125f) == 0x33u);
-    CHECK(closedVolumeFaces(low.data(), volume, kLo, kHi, 0.125f) == 0u);  // judged over whole faces: a quarter
+    CHECK(closedCubeFaces(low.data(), volume, kLo, glm::vec3(2.0f, -1.0f, 2.0f), 0.125f) == 0x33u);
+    CHECK(closedCubeFaces(low.data(), volume, kLo, kHi, 0.125f) == 0u);  // judged over whole faces: a quarter
 }
 
 TEST_CASE("a wall with a hole of a fifth of its face, or a model in the middle, closes nothing", "[ray]") {
@@ -83,10 +88,10 @@ TEST_CASE("a wall with a hole of a fifth of its face, or a model in the middle, 
         for (uint32_t i : {0u, 1u, 2u, 0u, 2u, 3u}) frame.indices.push_back(base + i);
     };
     strip(-2.0f, -h, -2.0f, 2.0f), strip(h, 2.0f, -2.0f, 2.0f), strip(-h, h, -2.0f, -h), strip(-h, h, h, 2.0f);
-    CHECK(closedVolumeFaces(holed.data(), volume, kLo, kHi, 0.125f) == 0x1u);
-    CHECK(closedVolumeFaces(frame.data(), volume, kLo, kHi, 0.125f) == 0u);  // 20 % of its rays pass
+    CHECK(closedCubeFaces(holed.data(), volume, kLo, kHi, 0.125f) == 0x1u);
+    CHECK(closedCubeFaces(frame.data(), volume, kLo, kHi, 0.125f) == 0u);  // 20 % of its rays pass
     Walls model;
     model.square(1, 0.0f, -1.0f, 1.0f, 1.0f);
-    CHECK(closedVolumeFaces(model.data(), volume, kLo, kHi, 0.125f) == 0u);
-    CHECK(closedVolumeFaces(RayMeshData{}, volume, kLo, kHi, 0.125f) == 0u);
+    CHECK(closedCubeFaces(model.data(), volume, kLo, kHi, 0.125f) == 0u);
+    CHECK(closedCubeFaces(RayMeshData{}, volume, kLo, kHi, 0.125f) == 0u);
 }

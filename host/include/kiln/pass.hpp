@@ -231,8 +231,9 @@ namespace kiln {
 // SceneView::materialTextures; 16: GpuFrame::voxelVolume, and the scene model's names:
 // kScenePlanes, kSceneLightSurface, kSceneRoundCones, kSceneSpheres,
 // kSceneGlowingSpheres, kSceneLights, GpuFrame::ringsLight/ringsDark, roundCone,
-// closedFaces), so a module built for other terms is refused by name, not run.
-inline constexpr uint32_t kPassAbiVersion = 17;
+// closedFaces; 18: GpuFrame::voxelExtent, and 3D SizeRule::fromParam grids shaped by
+// the scene's voxel volume), so a module built for other terms is refused by name, not run.
+inline constexpr uint32_t kPassAbiVersion = 18;
 
 struct TextureRef {
     GLuint id = 0;

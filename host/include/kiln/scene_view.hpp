@@ -6,6 +6,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 
 #include <glm/glm.hpp>
@@ -91,20 +92,47 @@ struct GpuFrame {
                              //   2a+1 for +axis a; 0: every face open
     glm::vec4 sceneMin;      // the scene's bounds (every instance's, world space); w unused
     glm::vec4 sceneMax;
-    // The cube the voxel passes cover (voxelVolumeAround): xyz its centre, w half its
-    // side, world space; shaders map through kilnWorldToVolume and kin (frame.glsl).
+    // The volume the voxel passes cover, the scene's bounds (voxelVolumeAround): xyz its
+    // centre, w half its longest side, world space. Volume space is the world moved to
+    // the centre and divided by w, so the volume is [-e, e] there with e = voxelExtent.xyz
+    // (the longest axis's 1) and distances keep one scale on every axis; the grid's
+    // texture coordinates are volume space ÷ e, mapped to [0,1]³ (frame.glsl's
+    // kilnWorldToVolume, kilnVolumeTexcoord and kin).
     glm::vec4 voxelVolume{0.0f, 0.0f, 0.0f, 1.0f};
+    glm::vec4 voxelExtent{1.0f, 1.0f, 1.0f, 0.0f};  // xyz: e, w unused
     glm::uvec4 punctualCount;  // x: lights[0 .. x) hold punctual lights
     GpuPunctualLight punctual[kMaxPunctualLights];
 };
 
-// The voxel volume of a scene with bounds [lo, hi]: the smallest cube around them,
-// centred on them (voxels are cubes, so the cone tracer's apertures hold on every axis).
-// A scene of [-1,1]³ gets exactly that cube.
+// The voxel volume of a scene with bounds [lo, hi] (GpuFrame::voxelVolume): centred on
+// them, w half their longest side. A scene of [-1,1]³ gets exactly that cube.
 inline glm::vec4 voxelVolumeAround(glm::vec3 lo, glm::vec3 hi) {
     const glm::vec3 half = 0.5f * (hi - lo);
     const float halfSide = std::max(std::max(half.x, half.y), std::max(half.z, 1e-3f));
     return glm::vec4(0.5f * (lo + hi), halfSide);
+}
+
+// Its extent on each axis over the longest (GpuFrame::voxelExtent): the volume is the
+// bounds themselves, so a room's walls lie in the grid's outermost cells (a face the
+// scene closes, GpuFrame::closedFaces, then holds them), not inside empty space that
+// coarse lookups would average them with. At least 1/64 on every axis.
+inline glm::vec3 voxelExtentAround(glm::vec3 lo, glm::vec3 hi) {
+    const glm::vec3 half = glm::max(0.5f * (hi - lo), glm::vec3(0.0f));
+    const float longest = std::max(std::max(half.x, half.y), std::max(half.z, 1e-3f));
+    return glm::clamp(half / longest, glm::vec3(1.0f / 64.0f), glm::vec3(1.0f));
+}
+
+// How many times a voxel grid's side (the resolution, along the longest axis) halves
+// along each axis of a volume of that extent: the power of two nearest the extent, at
+// most 1/4, so every level of a mip chain halves exactly. A cell is then at most √2
+// longer or shorter along a short axis than along the longest (exactly a cube where the
+// extent is a power of two, as a cube's 1, 1, 1), and a scene flatter than a
+// quarter gets cells flatter than cubes.
+inline glm::ivec3 voxelGridShift(glm::vec3 extent) {
+    glm::ivec3 shift;
+    for (int a = 0; a < 3; ++a)
+        shift[a] = std::clamp(int(std::lround(-std::log2(std::max(extent[a], 1e-6f)))), 0, 2);
+    return shift;
 }
 
 // GpuFrame::closedFaces.x of a volume closed on every face, or on all but +z.
