@@ -194,6 +194,16 @@ TEST_CASE("resolveSize", "[plan][size]") {
     t.kind = TextureKind::Color3D;
     t.size = SizeRule::fromParam("res");
     CHECK(resolveSize(t, 1280, 720, params) == Extent{64, 64, 64});
+    // A grid shaped like the scene's bounds: each axis halved `shift` times; a slab
+    // atlas keeps its tiles along x; a 2D texture takes no shape.
+    const GridShape flat{{0, 1, 2}};
+    CHECK(resolveSize(t, 1280, 720, params, nullptr, flat) == Extent{64, 32, 16});
+    t.size = SizeRule::fromParam("res", 1.0f, 3);
+    CHECK(resolveSize(t, 1280, 720, params, nullptr, flat) == Extent{192, 32, 16});
+    t.kind = TextureKind::Color2D;
+    t.size = SizeRule::fromParam("size");
+    CHECK(resolveSize(t, 1280, 720, params, nullptr, flat) == Extent{2048, 2048, 1});
+    t.kind = TextureKind::Color3D;
     t.size = SizeRule::fixed(32, 16, 8);
     CHECK(resolveSize(t, 1280, 720, params) == Extent{32, 16, 8});
     CHECK(describeSize(t, params) == "32x16x8");
