@@ -275,7 +275,7 @@ private:
             beginRaster(ctx, recorder, res, staticSums.id);
             glUniform1f(glGetUniformLocation(recorder, "u_emissionScale"), 1.0f);
             glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kStaticBinding, staticFragments_.id());
-            ctx.drawScene({.categories = kiln::kScenePlanes | kiln::kSceneMeshes, .lod = kiln::Lod::Low});
+            drawSided(ctx, recorder, kiln::kScenePlanes | kiln::kSceneMeshes);
             glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
             glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
                             GL_BUFFER_UPDATE_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
@@ -329,6 +329,18 @@ private:
         glUniform1i(glGetUniformLocation(raster, "u_axisViewportStep"), axisStep);
     }
 
+    // `categories` into the sums `program` is set up for, the double-sided meshes apart
+    // (voxelize.frag lights them on the side their light falls on).
+    static void drawSided(kiln::PassContext& ctx, GLuint program, uint32_t categories) {
+        const GLint twoSided = glGetUniformLocation(program, "u_twoSided");
+        glUniform1i(twoSided, 0);
+        ctx.drawScene({.categories = categories, .lod = kiln::Lod::Low, .sides = kiln::Sides::OneSided});
+        if (!(categories & kiln::kSceneMeshes)) return;
+        glUniform1i(twoSided, 1);
+        ctx.drawScene({.categories = kiln::kSceneMeshes, .lod = kiln::Lod::Low, .sides = kiln::Sides::TwoSided});
+        glUniform1i(twoSided, 0);
+    }
+
     // The lamp dome into the sums `raster` is set up for (beginRaster): at lamp_emission,
     // unshadowed (it is the emitter; nothing comes between it and the shadow map's eye).
     static void drawDome(kiln::PassContext& ctx, GLuint raster) {
@@ -349,7 +361,7 @@ private:
         if (rasterParticles) cats |= kiln::kSceneParticles;
         if (ctx.getBool("marbles")) cats |= kiln::kSceneSpheres;
         glUniform1f(emissionScale, 1.0f);
-        ctx.drawScene({.categories = cats, .lod = kiln::Lod::Low});
+        drawSided(ctx, raster, cats);
         if (rasterFireballs) {
             glUniform1f(emissionScale, ctx.getFloat("fireball_emission"));
             glUniform1i(glGetUniformLocation(raster, "u_sphereFlux"), ctx.getBool("fireball_flux") ? 1 : 0);

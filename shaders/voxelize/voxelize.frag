@@ -29,6 +29,20 @@ ivec3 voxelAt(int k, ivec2 ij, int axis) { return axis == 0 ? ivec3(k, ij.x, ij.
 uniform float u_emissionScale;  // 1, or lamp_emission while drawing the lamp
 uniform int u_axisViewportStep;  // the axes' viewports lie this many pixels apart in x (voxelize.geom)
 uniform bool u_sphereFlux;      // the fireballs: scale each to its sphere's flux (below)
+uniform bool u_twoSided;        // a double-sided material (voxelize.cpp draws those apart)
+
+// A double-sided surface as the side its light falls on: n, or −n where the lights reach
+// that side more. A voxel keeps one radiance and one normal, so the lit side is the one
+// it shows; with the normal as authored, a room's walls wound outward were lit from
+// behind (black) and their voxels faced away from the room.
+vec3 sideLit(vec3 p, vec3 n) {
+    vec3 front = lampIrradiance(p, n), back = lampIrradiance(p, -n);
+#if KILN_PUNCTUAL
+    front += punctualIrradiance(p, n), back += punctualIrradiance(p, -n);
+#endif
+    const vec3 luma = vec3(0.2126, 0.7152, 0.0722);
+    return dot(back, luma) > dot(front, luma) ? -n : n;
+}
 
 void main() {
     // Depth along the projection axis at this pixel, and how much it varies across it:
@@ -47,6 +61,7 @@ void main() {
     vec3 albedo = inst.albedo.rgb;
     if (inst.albedo.a > 0.5) albedo = woodGrain(v_world);
     vec3 n = normalize(v_normal);
+    if (u_twoSided) n = sideLit(v_world, n);
     float scale = u_emissionScale;
     if (u_sphereFlux) scale *= sphereFluxScale(kilnSphereRadius(inst));
     uvec3 emitted = toFixedRadiance(inst.emissive.rgb * scale);
