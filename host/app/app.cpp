@@ -123,12 +123,15 @@ uint32_t App::meshClosedFaces(const glm::vec4& volume, glm::vec3 extent) {
     const uint64_t meshes = renderer_.version(kSceneMeshes);
     if (meshes != closedFacesMeshes_ || volume != closedFacesVolume_ || extent != closedFacesExtent_) {
         closedFacesMeshes_ = meshes, closedFacesVolume_ = volume, closedFacesExtent_ = extent;
-        // Within one cell of the coarsest grid voxelize offers (32 along the longest side)
-        // of the face.
+        // Within two cells of the coarsest grid voxelize offers (32 along the longest side)
+        // of the face: walls drawn to overlap at the corners put the bounds past them, and
+        // a wall that far in is still in the outermost texel of every coarse level that a
+        // lookup past the face clamps to (an empty border there faded it: a closed room
+        // lost a third of its second bounce, tests/gi/test_bounces.cpp).
         const glm::vec3 half = volume.w * extent;
         const glm::vec3 cells = glm::vec3(glm::ivec3(32) >> voxelGridShift(extent));
         closedFaces_ = ray::closedVolumeFaces(renderer_.rayMeshData(), glm::vec3(volume), half, scene_.boundsMin(),
-                                              scene_.boundsMax(), 2.0f * half / cells);
+                                              scene_.boundsMax(), 4.0f * half / cells);
     }
     return closedFaces_;
 }
