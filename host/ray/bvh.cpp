@@ -57,7 +57,7 @@ Split bestSplit(std::span<const Aabb> bounds, const uint32_t* begin, const uint3
 
 }  // namespace
 
-Bvh buildBvh(std::span<const Aabb> bounds, uint32_t maxLeaf) {
+Bvh buildBvh(std::span<const Aabb> bounds, uint32_t maxLeaf, uint32_t maxDepth) {
     Bvh bvh;
     bvh.order.reserve(bounds.size());
     for (uint32_t i = 0; i < uint32_t(bounds.size()); ++i)
@@ -67,8 +67,19 @@ Bvh buildBvh(std::span<const Aabb> bounds, uint32_t maxLeaf) {
     bvh.nodes.reserve(2 * bvh.order.size() / std::min<size_t>(maxLeaf, 2) + 1);
     bvh.nodes.push_back({glm::vec3(0.0f), 0, glm::vec3(0.0f), uint32_t(bvh.order.size())});
 
-    struct Task { uint32_t node, first, count; };
-    std::vector<Task> tasks{{0, 0, uint32_t(bvh.order.size())}};
+    struct Task { uint32_t node, first, count, depth; };
+    std::vector<Task> tasks{{0, 0, uint32_t(bvh.order.size()), 0}};
+    // Makes task's node an interior one over two new nodes: its first leftCount
+    // primitives and the rest.
+    auto pushChildren = [&](const Task& task, uint32_t leftCount) {
+        const uint32_t children = uint32_t(bvh.nodes.size());
+        bvh.nodes[task.node].first = children;
+        bvh.nodes[task.node].count = 0;
+        bvh.nodes.push_back({});
+        bvh.nodes.push_back({});
+        tasks.push_back({children, task.first, leftCount, task.depth + 1});
+        tasks.push_back({children + 1, task.first + leftCount, task.count - leftCount, task.depth + 1});
+    };
     while (!tasks.empty()) {
         const Task task = tasks.back();
         tasks.pop_back();
@@ -78,7 +89,22 @@ Bvh buildBvh(std::span<const Aabb> bounds, uint32_t maxLeaf) {
         for (const uint32_t* p = begin; p != end; ++p) box.grow(bounds[*p]), centres.grow(bounds[*p].centre());
         BvhNode& node = bvh.nodes[task.node];
         node = {box.lo, task.first, box.hi, task.count};
-        if (task.count <= 1) continue;
+        if (task.count <= 1 || task.depth >= maxDepth) continue;
+
+        // Halvings from here to leaves of maxLeaf; once they need every level left,
+        // median splits keep the subtree within maxDepth.
+        uint32_t halvings = 0;
+        while ((uint64_t(maxLeaf) << halvings) < task.count) ++halvings;
+        if (halvings >= maxDepth - task.depth) {
+            const glm::vec3 extent = centres.hi - centres.lo;
+            const int axis = extent.x >= extent.y && extent.x >= extent.z ? 0 : (extent.y >= extent.z ? 1 : 2);
+            uint32_t* median = begin + task.count / 2;
+            std::nth_element(begin, median, end, [&](uint32_t a, uint32_t b) {
+                return bounds[a].centre()[axis] < bounds[b].centre()[axis];
+            });
+            pushChildren(task, uint32_t(median - begin));
+            continue;
+        }
 
         const Split split = bestSplit(bounds, begin, end, centres);
         const float leafCost = float(task.count);
@@ -94,14 +120,7 @@ Bvh buildBvh(std::span<const Aabb> bounds, uint32_t maxLeaf) {
             if (task.count <= std::max(maxLeaf, split.axis < 0 ? kForcedSplitAbove : maxLeaf)) continue;
             middle = begin + task.count / 2;  // coincident centres: split the list
         }
-        const uint32_t leftCount = uint32_t(middle - begin);
-        const uint32_t children = uint32_t(bvh.nodes.size());
-        bvh.nodes[task.node].first = children;
-        bvh.nodes[task.node].count = 0;
-        bvh.nodes.push_back({});
-        bvh.nodes.push_back({});
-        tasks.push_back({children, task.first, leftCount});
-        tasks.push_back({children + 1, task.first + leftCount, task.count - leftCount});
+        pushChildren(task, uint32_t(middle - begin));
     }
     return bvh;
 }

@@ -44,12 +44,20 @@ struct Bvh {
     std::vector<uint32_t> order;  // primitive indices in leaf order
 };
 
+// The deepest a hierarchy goes (edges from the root to a leaf): the shaders walk it
+// nearest child first with a stack of this many entries, one pushed per level
+// (shaders/common/ray_meshes.glsl), so a deeper tree would lose what lay past it.
+inline constexpr uint32_t kMaxBvhDepth = 48;
+
 // Binned SAH (16 bins on each axis): a node is split where the surface-area cost is
 // least, and becomes a leaf when no split is cheaper than testing its primitives, at
 // most `maxLeaf` of them (a node of more whose primitives' centres coincide is split
 // in the middle of the list, so no leaf grows without bound on degenerate input).
-// Primitives with empty bounds are left out.
-Bvh buildBvh(std::span<const Aabb> bounds, uint32_t maxLeaf = 4);
+// Primitives with empty bounds are left out. No leaf lies deeper than `maxDepth`: where
+// the SAH's cuts would take a subtree past it, the node is split at the median along
+// its centres' longest axis instead (so what is left halves to leaves of `maxLeaf` in
+// the levels left), and a node at `maxDepth` is a leaf whatever its count.
+Bvh buildBvh(std::span<const Aabb> bounds, uint32_t maxLeaf = 4, uint32_t maxDepth = kMaxBvhDepth);
 
 // The bounds of `box` moved by the affine transform `m` (its eight corners').
 Aabb transformed(const Aabb& box, const glm::mat4& m);

@@ -99,6 +99,8 @@ bool kilnTraceMeshes(vec3 o, vec3 d, float tMin, float tMax, out KilnMeshHit hit
     hit = KilnMeshHit(tMax, 0u, 0u, vec2(0.0));
     if (u_rayInstanceCount == 0u) return false;
     bool found = false;
+    // 48: host/ray/bvh.hpp kMaxBvhDepth, the deepest the host builds a hierarchy (a push
+    // per level), so the `top < 48` guards below never drop a subtree.
     uint stack[48];
     int top = 0;
     // The top level's stack holds nodes; a leaf's instances are traced at once.

@@ -121,6 +121,44 @@ TEST_CASE("a BVH over coincident triangles ends, its leaves bounded", "[ray]") {
     CHECK(buildBvh(std::vector<Aabb>{}).nodes.empty());
 }
 
+TEST_CASE("a BVH is never deeper than its depth limit (the shaders' traversal stack)", "[ray]") {
+    // The shaders walk a hierarchy with a stack of kMaxBvhDepth entries, one pushed per
+    // level, so a deeper tree would lose the subtrees past it. Scattered triangles whose
+    // SAH tree is deeper than a limit of 8 are built within it: median splits where the
+    // SAH's cuts would pass it, leaves no larger than the 2000 / 2^8 the limit forces,
+    // every triangle still in one leaf. The limit must have acted: without it the tree is
+    // deeper (and within the shaders' stack).
+    const Soup soup = randomSoup(2000, 0.05f, 11);
+    std::vector<Aabb> bounds(2000);
+    for (size_t t = 0; t < bounds.size(); ++t)
+        for (int k = 0; k < 3; ++k) bounds[t].grow(soup.positions[soup.indices[3 * t + size_t(k)]]);
+    auto deepestLeaf = [&](const Bvh& bvh, uint32_t largestLeaf) {
+        std::vector<int> seen(bounds.size(), 0);
+        std::vector<std::pair<uint32_t, int>> stack{{0u, 0}};
+        int deepest = 0;
+        while (!stack.empty()) {
+            const auto [i, depth] = stack.back();
+            stack.pop_back();
+            deepest = std::max(deepest, depth);
+            const BvhNode& n = bvh.nodes[i];
+            if (n.count == 0) {
+                stack.push_back({n.first, depth + 1}), stack.push_back({n.first + 1, depth + 1});
+                continue;
+            }
+            CHECK(n.count <= largestLeaf);
+            for (uint32_t k = n.first; k < n.first + n.count; ++k) ++seen[bvh.order[k]];
+        }
+        for (int s : seen) REQUIRE(s == 1);
+        return deepest;
+    };
+    const int free = deepestLeaf(buildBvh(bounds, 4), 4);
+    const int limited = deepestLeaf(buildBvh(bounds, 4, 8), 8);
+    INFO("deepest leaf: " << free << " by the SAH alone, " << limited << " limited to 8");
+    CHECK(free > 8);
+    CHECK(free <= int(kMaxBvhDepth));
+    CHECK(limited <= 8);
+}
+
 TEST_CASE("rays through two levels find the nearest triangle that testing every one finds", "[ray]") {
     // Two meshes — scattered triangles, and a 20 × 20 grid of quads (many shared edges,
     // where a ray meets two triangles at once) — placed five times with rotations, uniform
