@@ -19,6 +19,8 @@
 #ifndef KILN_BRIGHT_SPARSE
 #define KILN_BRIGHT_SPARSE 1
 #endif
+#include "common/luminance.glsl"
+
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(binding = 0) uniform sampler2D u_color;
 layout(binding = 0, rgba16f) uniform writeonly image2D u_bright;
@@ -33,7 +35,7 @@ void main() {
     ivec2 q = u_origin + ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(q, imageSize(u_bright)))) return;
     vec3 c = textureLod(u_color, vec2(2 * q + 1) / vec2(size), 0.0).rgb;
-    float l = dot(c, vec3(0.2126, 0.7152, 0.0722));
+    float l = kilnLuminance(c);
     if (!(l > u_threshold)) {  // NaN is not bright either
 #if !KILN_BRIGHT_SPARSE
         imageStore(u_bright, q, vec4(0.0, 0.0, 0.0, 1.0));

@@ -4,6 +4,7 @@
 // of a one-sided material is not hit (glTF culls it); where a material is alpha-masked
 // the base colour's coverage at the hit decides (a cut-out lets the ray through).
 // Needs common/instances.glsl; takes shader storage bindings 2–7 (kiln/scene_view.hpp).
+#include "common/luminance.glsl"
 struct KilnRayNode {
     vec3 lo;
     uint first;   // interior (count 0): children first, first + 1; leaf: first primitive
@@ -215,7 +216,6 @@ KilnMeshSurface kilnMeshSurface(KilnMeshHit hit) {
 // uniformly (u, v, w uniform in [0, 1)). `hit` names the triangle and the point as a
 // ray hit would (kilnMeshSurface gives its material there); areaDensity is the sample's
 // density per unit area, which kilnEmitterDensity gives for a point a path hit itself.
-float kilnLuminance(vec3 c) { return dot(c, vec3(0.2126, 0.7152, 0.0722)); }
 float kilnEmitterDensity(uint instance) {
     return u_rayEmittedPower > 0.0 ? kilnLuminance(kiln_instances[instance].emissive.rgb) / u_rayEmittedPower : 0.0;
 }

@@ -1,4 +1,5 @@
 #version 450 core
+#include "common/luminance.glsl"
 #include "common/tonemap.glsl"
 
 in vec2 v_uv;
@@ -40,7 +41,7 @@ void main() {
     }
     vec3 d = image - reference;
     if (u_mode == 1) {
-        float s = dot(d, vec3(0.2126, 0.7152, 0.0722)) / u_scale;
+        float s = kilnLuminance(d) / u_scale;
         o_color = vec4(s > 0.0 ? vec3(1.0, 1.0 - s, 1.0 - s) : vec3(1.0 + s, 1.0 + s, 1.0), 1.0);
         o_color.rgb = clamp(o_color.rgb, 0.0, 1.0);
         return;

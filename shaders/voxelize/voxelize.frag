@@ -6,6 +6,7 @@
 #include "common/frame.glsl"
 #include "common/instances.glsl"
 #include "common/light.glsl"
+#include "common/luminance.glsl"
 #include "common/shadow.glsl"
 #include "common/wood.glsl"
 #include "sums.glsl"
@@ -40,8 +41,7 @@ vec3 sideLit(vec3 p, vec3 n) {
 #if KILN_PUNCTUAL
     front += punctualIrradiance(p, n), back += punctualIrradiance(p, -n);
 #endif
-    const vec3 luma = vec3(0.2126, 0.7152, 0.0722);
-    return dot(back, luma) > dot(front, luma) ? -n : n;
+    return kilnLuminance(back) > kilnLuminance(front) ? -n : n;
 }
 
 void main() {
