@@ -129,9 +129,9 @@ uint32_t App::meshClosedFaces(const glm::vec4& volume, glm::vec3 extent) {
         // lookup past the face clamps to (an empty border there faded it: a closed room
         // lost a third of its second bounce, tests/gi/test_bounces.cpp).
         const glm::vec3 half = volume.w * extent;
-        const glm::vec3 cells = glm::vec3(glm::ivec3(32) >> voxelGridShift(extent));
+        const glm::vec3 cell = 2.0f * half / glm::vec3(glm::ivec3(32) >> voxelGridShift(extent));
         closedFaces_ = ray::closedVolumeFaces(renderer_.rayMeshData(), glm::vec3(volume), half, scene_.boundsMin(),
-                                              scene_.boundsMax(), 4.0f * half / cells);
+                                              scene_.boundsMax(), 2.0f * cell);
     }
     return closedFaces_;
 }
