@@ -1,9 +1,13 @@
 #!/usr/bin/python3
 """Draws the benchmark commands' figures from the CSV files they write (matplotlib).
 
-    plot.py quality  quality.csv OUT.png [--highlight LABEL]...
-    plot.py growth   growth.csv  OUT.png
-    plot.py sim      sim_rocking.csv OUTDIR
+    plot.py quality  quality.csv OUT.png [--highlight LABEL]... [--about TEXT]
+    plot.py growth   growth.csv  OUT.png [--about TEXT]
+    plot.py sim      sim_rocking.csv OUTDIR [--about TEXT]
+
+--about is the title's second line: what was measured where and when (the picture's size,
+the device, the date), which the benchmarks pass; a figure redrawn by hand from an older
+CSV gets it only if told.
 
 The benchmarks call it themselves after writing their CSV; it can be rerun by hand on
 any earlier CSV (to restyle a figure without measuring again). /usr/bin/python3 on
@@ -31,6 +35,13 @@ def number(text):
         return float(text)
     except (TypeError, ValueError):
         return float("nan")
+
+
+ABOUT = ""  # --about: the title's second line
+
+
+def titled(ax, title):
+    ax.set_title(title + ("\n" + ABOUT if ABOUT else ""), fontsize=11)
 
 
 def finish(fig, ax, out):
@@ -100,7 +111,7 @@ def plot_quality(rows, out, highlights):
     label_without_collisions(ax, points, marked)
     ax.set_xlabel("total GPU ms per frame")
     ax.set_ylabel("relative MSE less the reference's own noise (emitters masked)")
-    ax.set_title("GPU time against error versus the path-traced reference")
+    titled(ax, "GPU time against error versus the path-traced reference")
     ax.legend(loc="best", fontsize=8, framealpha=0.9)
     if off_axis:
         print("not on the plot (corrected relMSE <= 0: within the reference's noise): " + ", ".join(off_axis))
@@ -124,7 +135,7 @@ def plot_growth(rows, out):
     ax.set_ylim(bottom=0)
     ax.set_xlabel(kind)
     ax.set_ylabel("frame ms (wall, glFinish); labels: ratio to the first count")
-    ax.set_title(f"frame cost against {kind}, the scene moving")
+    titled(ax, f"frame cost against {kind}, the scene moving")
     ax.legend(fontsize=8)
     finish(fig, ax, out)
 
@@ -149,7 +160,7 @@ def plot_sim(rows, outdir):
                     ax.plot(*zip(*pairs), "-" + marker, markersize=4, label=f"{what}, {sub} sub-step{'s' * (sub > 1)}")
         ax.set_xlabel(xlabel)
         ax.set_ylabel("relative error")
-        ax.set_title(title)
+        titled(ax, title)
         ax.legend(fontsize=8)
         finish(fig, ax, os.path.join(outdir, name))
 
@@ -160,7 +171,10 @@ def main():
     parser.add_argument("csv")
     parser.add_argument("out", help="the PNG to write (for sim: the folder)")
     parser.add_argument("--highlight", action="append", default=[], help="quality: a setting to mark and name")
+    parser.add_argument("--about", default="", help="the title's second line: size, device, date")
     args = parser.parse_args()
+    global ABOUT
+    ABOUT = args.about
     try:
         rows = read_rows(args.csv)
     except OSError as e:

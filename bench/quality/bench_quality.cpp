@@ -849,6 +849,9 @@ nlohmann::json summary(const Args& args, const std::string& device, double scene
 bool plotQuality(const Args& args, const std::string& csvPath, const std::string& pngPath, std::string& error) {
     std::vector<std::string> plotArgs{"quality", csvPath, pngPath};
     for (auto& also : args.also) plotArgs.insert(plotArgs.end(), {"--highlight", fs::path(also).stem().string()});
+    const char* device = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+    plotArgs.insert(plotArgs.end(), {"--about", kiln::plotAbout(std::to_string(args.width) + "x" + std::to_string(args.height) +
+                                                                ", " + (device ? device : "unknown GL renderer"))});
     return kiln::drawPlot(plotArgs, error);
 }
 

@@ -354,7 +354,10 @@ void reportGrowth(const Args& args, const std::vector<Config>& configs, std::vec
     csv.close();  // complete on disk before the plot script reads it
     std::string error;
     const std::string png = (fs::path(args.outDir) / "growth.png").string();
-    if (kiln::drawPlot({"growth", csvPath, png}, error)) std::printf("wrote %s and %s\n", csvPath.c_str(), png.c_str());
+    const char* device = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+    const std::string about = kiln::plotAbout(std::to_string(args.width) + "x" + std::to_string(args.height) + ", " +
+                                              (device ? device : "unknown GL renderer"));
+    if (kiln::drawPlot({"growth", csvPath, png, "--about", about}, error)) std::printf("wrote %s and %s\n", csvPath.c_str(), png.c_str());
     else std::fprintf(stderr, "kiln-bench-render: %s: %s\n", png.c_str(), error.c_str());
 }
 

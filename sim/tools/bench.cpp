@@ -303,7 +303,8 @@ bool benchContactScene(const Scene& scene, const Out& out, bool quick) {
 // matplotlib draws them from sim_rocking.csv (scripts/plot.py).
 bool writePlots(const Out& out) {
     std::string error;
-    if (!kiln::drawPlot({"sim", (fs::path(out.dir) / "sim_rocking.csv").string(), out.dir}, error)) {
+    const std::string about = kiln::plotAbout("the simulation alone, one thread of " + kiln::cpuModel());
+    if (!kiln::drawPlot({"sim", (fs::path(out.dir) / "sim_rocking.csv").string(), out.dir, "--about", about}, error)) {
         std::fprintf(stderr, "kiln-sim: error: %s\n", error.c_str());
         return false;
     }

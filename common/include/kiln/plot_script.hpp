@@ -10,6 +10,8 @@
 
 #include <cerrno>
 #include <cstring>
+#include <ctime>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -18,6 +20,26 @@
 extern char** environ;
 
 namespace kiln {
+
+// A figure's `--about` line: what it was measured on (the picture's size, the device),
+// and today's date, so a figure copied into the documentation says where it came from.
+inline std::string plotAbout(const std::string& sizeAndDevice) {
+    char date[16] = "";
+    const std::time_t now = std::time(nullptr);
+    std::tm utc{};
+    if (gmtime_r(&now, &utc)) std::strftime(date, sizeof date, "%Y-%m-%d", &utc);
+    return sizeAndDevice + ", " + date;
+}
+
+// The CPU's model as /proc/cpuinfo names it (for a figure of CPU-only work), or "CPU".
+inline std::string cpuModel() {
+    std::ifstream info("/proc/cpuinfo");
+    for (std::string line; std::getline(info, line);)
+        if (line.rfind("model name", 0) == 0)
+            if (const size_t colon = line.find(':'); colon != std::string::npos && colon + 2 <= line.size())
+                return line.substr(colon + 2);
+    return "CPU";
+}
 
 // Runs `plot.py arguments...` and waits for it. On failure returns false and says why in
 // `error` (the script's own message went to stderr); the CSV it was given stays.
