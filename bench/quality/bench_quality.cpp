@@ -846,12 +846,11 @@ nlohmann::json summary(const Args& args, const std::string& device, double scene
     };
 }
 
-bool plotQuality(const Args& args, const std::string& csvPath, const std::string& pngPath, std::string& error) {
+bool plotQuality(const Args& args, const std::string& device, const std::string& csvPath, const std::string& pngPath,
+                 std::string& error) {
     std::vector<std::string> plotArgs{"quality", csvPath, pngPath};
     for (auto& also : args.also) plotArgs.insert(plotArgs.end(), {"--highlight", fs::path(also).stem().string()});
-    const char* device = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
-    plotArgs.insert(plotArgs.end(), {"--about", kiln::plotAbout(std::to_string(args.width) + "x" + std::to_string(args.height) +
-                                                                ", " + (device ? device : "unknown GL renderer"))});
+    plotArgs.insert(plotArgs.end(), {"--about", kiln::plotAbout(args.width, args.height, device)});
     return kiln::drawPlot(plotArgs, error);
 }
 
@@ -901,7 +900,7 @@ int main(int argc, char** argv) {
     writeErrors(results, figures.ssimMeaningful, csvPath);
     printBias(results);
     const std::string pngPath = (fs::path(args.outDir) / "quality.png").string();
-    if (!plotQuality(args, csvPath, pngPath, error)) return fail(error) ? 0 : 1;
+    if (!plotQuality(args, context->description(), csvPath, pngPath, error)) return fail(error) ? 0 : 1;
 
     const std::string summaryPath = (fs::path(args.outDir) / "summary.json").string();
     std::ofstream(summaryPath) << summary(args, context->description(), app.scene().time(), results, figures, ref,

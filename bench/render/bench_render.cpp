@@ -321,7 +321,8 @@ void report(const Config& config, Measured& m, double floorMs, std::ofstream& cs
 // round's ratio to the first count measured in the same round, with its lowest and
 // highest: the machine's speed drifts between rounds by more than the two frames
 // differ within one (on the 2-core machine, ±10 % from minute to minute).
-void reportGrowth(const Args& args, const std::vector<Config>& configs, std::vector<Measured>& measured) {
+void reportGrowth(const Args& args, const std::string& device, const std::vector<Config>& configs,
+                  std::vector<Measured>& measured) {
     const std::string csvPath = (fs::path(args.outDir) / "growth.csv").string();
     std::ofstream csv(csvPath);
     csv << "pipeline," << args.growKind
@@ -354,9 +355,7 @@ void reportGrowth(const Args& args, const std::vector<Config>& configs, std::vec
     csv.close();  // complete on disk before the plot script reads it
     std::string error;
     const std::string png = (fs::path(args.outDir) / "growth.png").string();
-    const char* device = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
-    const std::string about = kiln::plotAbout(std::to_string(args.width) + "x" + std::to_string(args.height) + ", " +
-                                              (device ? device : "unknown GL renderer"));
+    const std::string about = kiln::plotAbout(args.width, args.height, device);
     if (kiln::drawPlot({"growth", csvPath, png, "--about", about}, error)) std::printf("wrote %s and %s\n", csvPath.c_str(), png.c_str());
     else std::fprintf(stderr, "kiln-bench-render: %s: %s\n", png.c_str(), error.c_str());
 }
@@ -401,7 +400,7 @@ int main(int argc, char** argv) {
     std::printf("floor: an empty full-screen pass at %dx%d (its coordinates written to RGBA16F) takes %.3f ms (wall, glFinish)\n\n",
                 args.width, args.height, floorMs);
     for (size_t i = 0; i < configs.size(); ++i) report(configs[i], measured[i], floorMs, csv);
-    if (!args.growKind.empty()) reportGrowth(args, configs, measured);
+    if (!args.growKind.empty()) reportGrowth(args, context->description(), configs, measured);
     std::printf("wrote %s\n", csvPath.c_str());
     return 0;
 }

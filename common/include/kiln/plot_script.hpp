@@ -31,6 +31,11 @@ inline std::string plotAbout(const std::string& sizeAndDevice) {
     return sizeAndDevice + ", " + date;
 }
 
+// The same for a rendered figure: its size in pixels and the GL device that drew it.
+inline std::string plotAbout(int width, int height, const std::string& device) {
+    return plotAbout(std::to_string(width) + "x" + std::to_string(height) + ", " + device);
+}
+
 // The CPU's model as /proc/cpuinfo names it (for a figure of CPU-only work), or "CPU".
 inline std::string cpuModel() {
     std::ifstream info("/proc/cpuinfo");
